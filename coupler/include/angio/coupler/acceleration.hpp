@@ -1,0 +1,27 @@
+// Acceleration of the Dirichlet–Neumann fixed-point iteration q_{k+1} = q_k + Δq_k (DESIGN §2
+// "Coupling iteration"). The coupling loop only sees this interface, so IQN-ILS or other schemes
+// can be added next to Aitken without touching the loop.
+#pragma once
+
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+
+namespace angio::coupler {
+
+class Acceleration {
+ public:
+  virtual ~Acceleration() = default;
+  // Called at the start of every load step (also after a rejected attempt).
+  virtual void begin_step() = 0;
+  // Given the current input q_k and the residual r_k = q~_k − q_k of iteration k (0-based within
+  // the step), returns the next input q_{k+1}.
+  virtual Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) = 0;
+  // Called when a step converged (e.g. to carry the last relaxation factor to the next step).
+  virtual void end_step(bool accepted) = 0;
+  // Relaxation factor used in the last update (for logging; 1 for schemes without one).
+  virtual double last_factor() const = 0;
+  virtual std::string name() const = 0;
+};
+
+}  // namespace angio::coupler

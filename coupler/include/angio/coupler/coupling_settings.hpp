@@ -1,0 +1,37 @@
+// The scene's `coupling:` section (DESIGN §2 "Coupling iteration").
+//   coupling:
+//     acceleration: aitken        # aitken | constant
+//     initial_relaxation: 0.5     # ω_0
+//     max_relaxation: 1.0         # cap on |ω|
+//     max_iterations: 50
+//     rel_tol: 1.0e-4             # ||r|| <= rel_tol·||q~|| + abs_tol·sqrt(len)
+//     abs_tol: 1.0e-6             # N/mm
+//     strict: true                # hitting max_iterations rejects the step (false: accept + warn)
+//     prediction: extrapolate     # constant | extrapolate: first iterate of a step
+//     record: false               # record every exchange into <run-dir>/exchanges.angiorec
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "angio/coupler/acceleration.hpp"
+#include "angio/scene/node.hpp"
+
+namespace angio::coupler {
+
+struct CouplingSettings {
+  std::string acceleration = "aitken";
+  double initial_relaxation = 0.5;
+  double max_relaxation = 1.0;
+  int max_iterations = 50;
+  double rel_tol = 1e-4;
+  double abs_tol = 1e-6;
+  bool strict = true;
+  std::string prediction = "extrapolate";
+  bool record = false;
+};
+
+CouplingSettings coupling_settings(const scene::Node& root);
+std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s);
+
+}  // namespace angio::coupler

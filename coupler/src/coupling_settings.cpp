@@ -1,0 +1,35 @@
+#include "angio/coupler/coupling_settings.hpp"
+
+#include "angio/coupler/aitken.hpp"
+
+namespace angio::coupler {
+
+CouplingSettings coupling_settings(const scene::Node& root) {
+  CouplingSettings s;
+  auto c = root.optional("coupling");
+  if (!c) return s;
+  c->check_keys({"acceleration", "initial_relaxation", "max_relaxation", "max_iterations",
+                 "rel_tol", "abs_tol", "strict", "prediction", "record"});
+  s.acceleration = c->choice_or("acceleration", {"aitken", "constant"}, s.acceleration);
+  if (c->has("initial_relaxation")) s.initial_relaxation = c->in_range("initial_relaxation", 1e-6, 2.0);
+  s.max_relaxation = c->has("max_relaxation") ? c->in_range("max_relaxation", 1e-6, 10.0)
+                                              : std::max(1.0, s.initial_relaxation);
+  if (s.max_relaxation < s.initial_relaxation)
+    c->child("max_relaxation").fail("a value >= coupling.initial_relaxation");
+  s.max_iterations = static_cast<int>(c->integer_or("max_iterations", s.max_iterations, 1));
+  s.rel_tol = c->non_negative_or("rel_tol", s.rel_tol);
+  s.abs_tol = c->non_negative_or("abs_tol", s.abs_tol);
+  if (s.rel_tol == 0.0 && s.abs_tol == 0.0)
+    c->fail("a positive coupling.rel_tol or coupling.abs_tol (both are 0: nothing can converge)");
+  s.strict = c->boolean_or("strict", s.strict);
+  s.prediction = c->choice_or("prediction", {"constant", "extrapolate"}, s.prediction);
+  s.record = c->boolean_or("record", s.record);
+  return s;
+}
+
+std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s) {
+  if (s.acceleration == "constant") return std::make_unique<ConstantRelaxation>(s.initial_relaxation);
+  return std::make_unique<Aitken>(s.initial_relaxation, s.max_relaxation);
+}
+
+}  // namespace angio::coupler

@@ -1,0 +1,155 @@
+// coupler: owns the load steps and the Dirichlet–Neumann coupling iteration of a run; talks to
+// beam_solver and solid_solver over zenoh and never touches element data (DESIGN §2).
+#include <chrono>
+#include <functional>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <memory>
+#include <optional>
+
+#include "angio/common/cli.hpp"
+#include "angio/common/log.hpp"
+#include "angio/coupler/coupling_loop.hpp"
+#include "angio/coupler/step_csv.hpp"
+#include "angio/participant/keys.hpp"
+#include "angio/participant/remote.hpp"
+#include "angio/recording/recording.hpp"
+#include "angio/scene/load_curve.hpp"
+#include "angio/transport.hpp"
+
+using namespace angio;
+namespace fs = std::filesystem;
+
+namespace {
+
+void write_summary(const fs::path& path, const std::string& status, const std::string& error,
+                   const coupler::RunReport& run, double messaging) {
+  std::ofstream o(path);
+  o << std::setprecision(10) << "{\n"
+    << "  \"status\": \"" << status << "\",\n"
+    << "  \"error\": \"" << error << "\",\n"  // already JSON-escaped by the caller
+    << "  \"steps\": " << run.steps << ",\n"
+    << "  \"rejected_attempts\": " << run.rejected_attempts << ",\n"
+    << "  \"coupling_iterations_total\": " << run.total_iterations << ",\n"
+    << "  \"coupling_iterations_mean\": "
+    << (run.steps ? double(run.total_iterations) / run.steps : 0.0) << ",\n"
+    << "  \"coupling_iterations_max\": " << run.max_iterations << ",\n"
+    << "  \"wall_time\": " << run.wall_time << ",\n"
+    << "  \"beam_time\": " << run.beam_time << ",\n"
+    << "  \"solid_time\": " << run.solid_time << ",\n"
+    << "  \"messaging_time\": " << messaging << ",\n"
+    << "  \"messaging_share\": " << (run.wall_time > 0 ? messaging / run.wall_time : 0.0) << "\n"
+    << "}\n";
+}
+
+std::string json_escape(std::string s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += (c == '\n') ? ' ' : c;
+  }
+  return out;
+}
+
+int run(const cli::Parser& args) {
+  const scene::Node root = scene::load_scene(args.get("scene"));
+  const scene::TimeSettings time = scene::time_settings(root);
+  const coupler::CouplingSettings settings = coupler::coupling_settings(root);
+  const scene::LoadCurves curves = scene::load_curves(root);
+  const auto pressure_curve = curves.count("pressure") ? curves.at("pressure") : scene::LoadCurve::constant(0.0);
+  const fs::path run_dir = args.get("run-dir");
+  fs::create_directories(run_dir);
+  const std::string run_id = args.get("run-id");
+  const auto timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
+
+  std::unique_ptr<recording::Recorder> recorder;
+  if (settings.record || args.has("record"))
+    recorder = std::make_unique<recording::Recorder>((run_dir / "exchanges.angiorec").string(), run_id);
+
+  auto session = transport::Session::open({{args.get("endpoint")}, {}});
+  auto token = session.declare_liveliness_token(participant::keys::alive(run_id, "coupler"));
+  participant::Channel beam_ch(session, run_id, fb::Role::Beam, timeout, recorder.get());
+  participant::Channel solid_ch(session, run_id, fb::Role::Solid, timeout, recorder.get());
+  participant::RemoteBeam beam(beam_ch);
+  participant::RemoteSolid solid(solid_ch);
+
+  const std::string beam_sw = beam.hello();
+  const std::string solid_sw = solid.hello();
+  LOG_INFO("run " << run_id << ": beam " << beam_sw << " (" << beam.sample_points().size()
+                  << " contact sample points), solid " << solid_sw << "; " << time.steps
+                  << " steps to t = " << time.end << " s, " << settings.acceleration
+                  << " acceleration");
+
+  coupler::StepCsv csv((run_dir / "coupling.csv").string());
+  auto acc = coupler::make_acceleration(settings);
+  coupler::RunReport report;
+  double messaging_before = 0.0;
+  try {
+    report = coupler::run_coupled(beam, solid, time, settings, *acc, [&](const coupler::StepReport& r) {
+      const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
+      const double step_messaging = messaging - messaging_before;
+      messaging_before = messaging;
+      const double p = pressure_curve.value(r.time);
+      csv.write(r, p, step_messaging);
+      LOG_INFO("step " << r.step << " t = " << r.time << " s p = " << p << " MPa: " << r.iterations
+                       << " coupling iterations, residual "
+                       << (r.residuals.empty() ? 0.0 : r.residuals.back()) << ", omega " << r.omega
+                       << ", " << r.contact.n_active << " active, wall " << std::setprecision(3)
+                       << r.wall_time << " s (beam " << r.beam_time << ", solid " << r.solid_time
+                       << ")");
+    });
+  } catch (const std::exception& e) {
+    LOG_ERROR(e.what());
+    write_summary(run_dir / "coupling_summary.json", "failed", json_escape(e.what()), report,
+                  beam_ch.messaging_time() + solid_ch.messaging_time());
+    // Tell the participants to finish so they close their output cleanly; their own errors are
+    // secondary to the one reported above.
+    auto quietly = [](const std::function<void()>& f) {
+      try {
+        f();
+      } catch (const std::exception& e) {
+        LOG_DEBUG("while shutting down: " << e.what());
+      }
+    };
+    quietly([&] { beam.finish(); });
+    quietly([&] { solid.finish(); });
+    return 3;
+  }
+  beam.finish();
+  solid.finish();
+  const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
+  write_summary(run_dir / "coupling_summary.json", "ok", "", report, messaging);
+  LOG_INFO("done: " << report.steps << " steps, coupling iterations mean "
+                    << (report.steps ? double(report.total_iterations) / report.steps : 0.0)
+                    << " max " << report.max_iterations << ", wall " << report.wall_time
+                    << " s, messaging " << 100.0 * messaging / std::max(report.wall_time, 1e-12)
+                    << " %");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::Parser args("coupler",
+                   "Runs the load steps and the Dirichlet-Neumann coupling iterations (Aitken) of a\n"
+                   "co-simulation; beam_solver and solid_solver connect to --endpoint.");
+  args.add_common();
+  args.add({"record", "", "record every exchanged message into <run-dir>/exchanges.angiorec", ""});
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    cli::setup_logging(args, "coupler");
+    if (!args.has("scene")) throw cli::UsageError("missing required option --scene (see --help)");
+    if (!args.has("endpoint")) throw cli::UsageError("missing required option --endpoint (see --help)");
+    return run(args);
+  } catch (const cli::UsageError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const scene::SceneError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    LOG_ERROR(e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,49 @@
+// Command-line options shared by the three executables, so every process answers to the same
+// flags: --scene FILE, --run-dir DIR, --endpoint E, --run-id ID, --timeout S, --log-level L.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace angio::cli {
+
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Option {
+  std::string name;         // without leading dashes, e.g. "scene"
+  std::string value_name;   // e.g. "FILE"; empty for a flag without value
+  std::string help;
+  std::string default_value;
+};
+
+class Parser {
+ public:
+  Parser(std::string program, std::string summary);
+  Parser& add(Option o);
+  Parser& add_common();  // scene, run-dir, endpoint, run-id, timeout, log-level, debug-log
+
+  // Returns false when --help was given (usage already printed). Throws UsageError otherwise.
+  bool parse(int argc, char** argv);
+
+  bool has(const std::string& name) const;
+  std::string get(const std::string& name) const;  // value or default; throws if neither
+  std::optional<std::string> maybe(const std::string& name) const;
+  double number(const std::string& name) const;
+  std::string usage() const;
+
+ private:
+  std::string program_, summary_;
+  std::vector<Option> options_;
+  std::map<std::string, std::string> values_;
+};
+
+// Applies --log-level and names the role in every log line.
+void setup_logging(const Parser& p, const std::string& role);
+
+}  // namespace angio::cli

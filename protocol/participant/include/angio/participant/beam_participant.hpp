@@ -1,0 +1,26 @@
+// What the stent side must do to take part in a run, standalone or coupled (DESIGN §2).
+// beam_solver implements it; a replay participant implements it from a recording.
+#pragma once
+
+#include "angio/participant/types.hpp"
+
+namespace angio::participant {
+
+class BeamParticipant {
+ public:
+  virtual ~BeamParticipant() = default;
+
+  // Current positions, weights and radii of the contact sample points.
+  virtual SamplePoints sample_points() const = 0;
+  // Sets prescribed loads/supports from the load curves at pseudo-time `time` (end of the step).
+  virtual void begin_step(int step, double time) = 0;
+  // Solves equilibrium with the external contact line loads (N/mm) at the sample points, in
+  // addition to the scene's own loads, starting from the current iterate.
+  virtual SolveStats solve(const std::vector<Vec3>& line_loads) = 0;
+  // accept: commit the plastic state and write output; reject: restore the last committed state.
+  virtual void end_step(bool accept) = 0;
+  // Close output files and write the summary.
+  virtual void finish() = 0;
+};
+
+}  // namespace angio::participant

@@ -1,0 +1,23 @@
+// What the balloon/artery side must do to take part in a run, standalone or coupled (DESIGN §2).
+// solid_solver implements it (collectively on all MPI ranks); a replay participant from a recording.
+#pragma once
+
+#include "angio/participant/types.hpp"
+
+namespace angio::participant {
+
+class SolidParticipant {
+ public:
+  virtual ~SolidParticipant() = default;
+
+  // Sets pressures etc. from the load curves at pseudo-time `time` (end of the step).
+  virtual void begin_step(int step, double time) = 0;
+  // Solves equilibrium with the beam sample points held fixed; fills the contact reply.
+  // Empty `beam_points` means no stent.
+  virtual SolveStats solve(const SamplePoints& beam_points, ContactReply& reply) = 0;
+  // accept: commit history and write output; reject: roll back to the last committed state.
+  virtual void end_step(bool accept) = 0;
+  virtual void finish() = 0;
+};
+
+}  // namespace angio::participant

@@ -1,0 +1,44 @@
+// Interface data exchanged between the beam and the solid side (DESIGN §2 "Interface data").
+// Plain C++ types so that neither solver depends on the other's linear algebra.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace angio::participant {
+
+using Vec3 = std::array<double, 3>;
+
+// Contact sample points along the stent centerline: the Gauss points of the beam's contact
+// integration. x: current position (mm), w: arc-length weight (mm), radius: contact radius (mm).
+struct SamplePoints {
+  std::vector<Vec3> x;
+  std::vector<double> w;
+  std::vector<double> radius;
+  std::size_t size() const { return x.size(); }
+};
+
+struct SolveStats {
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;
+  std::vector<double> residual_history;
+  std::string message;  // why it failed, for the error report
+};
+
+// Solid → beam: the contact line loads q (N/mm) acting on the beam at each sample point, and for
+// the robin mode the active surface point s, its unit normal n (toward the beam) and penalty eps.
+struct ContactReply {
+  std::vector<Vec3> line_loads;
+  std::vector<Vec3> surface_points;
+  std::vector<Vec3> normals;
+  std::vector<double> penalty;
+  std::vector<std::uint8_t> active;
+  int n_active = 0;
+  double min_gap = 0.0;  // most negative gap (largest penetration), mm
+  Vec3 total_force{0.0, 0.0, 0.0};  // sum of w·q over the points (N)
+};
+
+}  // namespace angio::participant

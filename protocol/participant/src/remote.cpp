@@ -1,0 +1,155 @@
+#include "angio/participant/remote.hpp"
+
+#include "angio/common/log.hpp"
+#include "angio/messages/builders.hpp"
+#include "angio/messages/convert.hpp"
+#include "angio/participant/keys.hpp"
+#include "angio/recording/recording.hpp"
+#include "angio/transport.hpp"
+
+namespace angio::participant {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+std::string lower_role(fb::Role r) {
+  switch (r) {
+    case fb::Role::Beam: return "beam";
+    case fb::Role::Solid: return "solid";
+    default: return "coupler";
+  }
+}
+}  // namespace
+
+Channel::Channel(const transport::Session& session, std::string run_id, fb::Role role,
+                 std::chrono::milliseconds timeout, recording::Recorder* recorder)
+    : session_(session),
+      run_id_(std::move(run_id)),
+      role_(role),
+      role_name_(lower_role(role)),
+      timeout_(timeout),
+      recorder_(recorder) {}
+
+bool Channel::alive(std::chrono::milliseconds timeout) const {
+  return session_.liveliness_alive(keys::alive(run_id_, role_name_), timeout);
+}
+
+msg::Buffer Channel::call(const std::string& verb, const Build& build) {
+  const std::uint64_t seq = sequence_.next();
+  msg::Buffer request = build(msg::Header{run_id_, seq, fb::Role::Coupler});
+  const auto t0 = Clock::now();
+  msg::Buffer reply;
+  try {
+    reply = session_.request(keys::request(run_id_, role_name_, verb), request, timeout_);
+  } catch (const transport::TimeoutError& e) {
+    throw transport::TimeoutError("the " + role_name_ + " participant did not answer '" + verb +
+                                  "' within " + std::to_string(timeout_.count() / 1000.0) +
+                                  " s (is it running? see its log): " + e.what());
+  }
+  timing_.round_trip = std::chrono::duration<double>(Clock::now() - t0).count();
+  timing_.solver_time = 0.0;
+  if (recorder_) recorder_->add(role_, verb, request, reply);
+  const fb::Envelope* env = nullptr;
+  try {
+    env = &msg::open(reply, run_id_);
+    sequence_.check_reply(*env, seq);
+  } catch (const msg::ProtocolError& e) {
+    throw ParticipantError("bad reply from the " + role_name_ + " participant to '" + verb +
+                           "': " + e.what());
+  }
+  if (env->sender() != role_)
+    throw ParticipantError("reply to '" + verb + "' came from role " +
+                           msg::role_name(env->sender()) + ", expected " + role_name_);
+  if (const auto* err = env->payload_as_Error())
+    throw ParticipantError("the " + role_name_ + " participant failed on '" + verb +
+                           "': " + flatbuffers::GetString(err->message()));
+  return reply;
+}
+
+namespace {
+// Opens a reply already verified by Channel::call and checks its payload type.
+template <class T>
+const T& reply_as(const msg::Buffer& b) {
+  return msg::payload_as<T>(*flatbuffers::GetRoot<fb::Envelope>(b.data()));
+}
+// Messaging overhead of a solve = round trip minus the time the participant spent solving.
+void account(Channel& ch, const fb::SolveStats* s) {
+  ch.timing().solver_time = s ? s->wall_time() : 0.0;
+  ch.add_messaging(ch.timing().round_trip - ch.timing().solver_time);
+}
+}  // namespace
+
+std::string RemoteBeam::hello() {
+  auto b = ch_.call("hello", [](const msg::Header& h) { return msg::hello(h, "coupler"); });
+  const auto& r = reply_as<fb::HelloReply>(b);
+  if (r.protocol_version() != msg::kProtocolVersion)
+    throw ParticipantError("beam participant speaks protocol " +
+                           std::to_string(r.protocol_version()));
+  points_ = msg::to_sample_points(r.sample_points());
+  return flatbuffers::GetString(r.software());
+}
+
+void RemoteBeam::begin_step(int step, double time) {
+  step_ = step;
+  time_ = time;
+  ch_.call("step_begin", [&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
+}
+
+SolveStats RemoteBeam::solve(const std::vector<Vec3>& q) {
+  auto b = ch_.call("solve", [&](const msg::Header& h) {
+    return msg::beam_solve_request(h, step_, iteration_, q);
+  });
+  const auto& r = reply_as<fb::BeamSolveReply>(b);
+  account(ch_, r.stats());
+  SamplePoints pts = msg::to_sample_points(r.sample_points());
+  if (pts.size() != points_.size())
+    throw ParticipantError("beam participant returned " + std::to_string(pts.size()) +
+                           " sample points, announced " + std::to_string(points_.size()));
+  points_ = std::move(pts);
+  return msg::to_stats(r.stats());
+}
+
+void RemoteBeam::end_step(bool accept) {
+  ch_.call("step_end", [&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
+}
+
+void RemoteBeam::finish() {
+  ch_.call("shutdown", [](const msg::Header& h) { return msg::shutdown(h, "run finished"); });
+}
+
+std::string RemoteSolid::hello() {
+  auto b = ch_.call("hello", [](const msg::Header& h) { return msg::hello(h, "coupler"); });
+  const auto& r = reply_as<fb::HelloReply>(b);
+  if (r.protocol_version() != msg::kProtocolVersion)
+    throw ParticipantError("solid participant speaks protocol " +
+                           std::to_string(r.protocol_version()));
+  return flatbuffers::GetString(r.software());
+}
+
+void RemoteSolid::begin_step(int step, double time) {
+  step_ = step;
+  time_ = time;
+  ch_.call("step_begin", [&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
+}
+
+SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply) {
+  auto b = ch_.call("solve", [&](const msg::Header& h) {
+    return msg::solid_solve_request(h, step_, iteration_, pts);
+  });
+  const auto& r = reply_as<fb::SolidSolveReply>(b);
+  account(ch_, r.stats());
+  reply = msg::to_contact(r);
+  if (!pts.x.empty() && reply.line_loads.size() != pts.size())
+    throw ParticipantError("solid participant returned " + std::to_string(reply.line_loads.size()) +
+                           " line loads for " + std::to_string(pts.size()) + " sample points");
+  return msg::to_stats(r.stats());
+}
+
+void RemoteSolid::end_step(bool accept) {
+  ch_.call("step_end", [&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
+}
+
+void RemoteSolid::finish() {
+  ch_.call("shutdown", [](const msg::Header& h) { return msg::shutdown(h, "run finished"); });
+}
+
+}  // namespace angio::participant

@@ -1,0 +1,154 @@
+#include "angio/participant/role_server.hpp"
+
+#include <chrono>
+#include <functional>
+
+#include "angio/common/log.hpp"
+#include "angio/messages/builders.hpp"
+#include "angio/messages/convert.hpp"
+#include "angio/participant/keys.hpp"
+#include "angio/transport.hpp"
+
+namespace angio::participant {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Turns one verified request into a reply; sets `stop` after a Shutdown.
+using Dispatch = std::function<msg::Buffer(const fb::Envelope&, const msg::Header&, bool& stop)>;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The loop shared by every role: receive, verify, check the sequence, dispatch, reply; watch the
+// coupler's liveliness token and the silence timeout so that a vanished coupler ends the process
+// with a clear error instead of a hang.
+int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
+  const std::string name = fb::EnumNameRole(role) == std::string("Beam") ? "beam" : "solid";
+  std::optional<transport::Session> session;
+  try {
+    session.emplace(transport::Session::open({{}, {o.endpoint}}));
+  } catch (const transport::TransportError& e) {
+    LOG_ERROR("cannot open the zenoh session to " << o.endpoint << ": " << e.what());
+    return 5;
+  }
+  auto token = session->declare_liveliness_token(keys::alive(o.run_id, name));
+  auto coupler = session->watch_liveliness(keys::alive(o.run_id, "coupler"));
+  auto queryable = session->declare_queryable(keys::serve(o.run_id, name));
+  LOG_DEBUG("serving " << keys::serve(o.run_id, name) << " via " << o.endpoint);
+
+  msg::Sequence sequence;
+  bool coupler_seen = false;
+  auto last_heard = Clock::now();
+  for (;;) {
+    auto q = queryable.recv(std::chrono::milliseconds(200));
+    if (!q) {
+      while (auto ev = coupler.recv(std::chrono::milliseconds(1))) {
+        if (ev->alive) {
+          coupler_seen = true;
+        } else if (coupler_seen) {
+          LOG_ERROR("the coupler disappeared (its liveliness token " << ev->key
+                                                                      << " is gone); exiting");
+          return 4;
+        }
+      }
+      if (Clock::now() - last_heard > o.timeout) {
+        LOG_ERROR("no request from the coupler for " << seconds_since(last_heard)
+                                                     << " s (--timeout); exiting");
+        return 4;
+      }
+      continue;
+    }
+    last_heard = Clock::now();
+    msg::Header h{o.run_id, 0, role};
+    bool stop = false;
+    try {
+      const fb::Envelope& env = msg::open(q->payload(), o.run_id);
+      h.sequence = env.sequence();
+      sequence.check_request(env);
+      q->reply(dispatch(env, h, stop));
+    } catch (const std::exception& e) {
+      // A bad message or a failing solver is answered with an Error; the coupler decides.
+      LOG_ERROR("request on " << q->key() << " failed: " << e.what());
+      q->reply(msg::error(h, e.what()));
+    }
+    if (stop) return 0;
+  }
+}
+
+msg::Buffer common(const fb::Envelope& env, const msg::Header& h, bool& stop,
+                   const std::function<void()>& finish) {
+  if (env.payload_type() == fb::Payload::Shutdown) {
+    LOG_DEBUG("shutdown: " << flatbuffers::GetString(env.payload_as_Shutdown()->reason()));
+    finish();
+    stop = true;
+    return msg::ack(h);
+  }
+  throw msg::ProtocolError(std::string("unexpected ") + msg::payload_name(env.payload_type()) +
+                           " request");
+}
+
+}  // namespace
+
+int serve(BeamParticipant& beam, const ServeOptions& o) {
+  return serve_role(fb::Role::Beam, o, [&](const fb::Envelope& env, const msg::Header& h, bool& stop) {
+    switch (env.payload_type()) {
+      case fb::Payload::Hello: {
+        auto pts = beam.sample_points();
+        return msg::hello_reply(h, o.software, &pts);
+      }
+      case fb::Payload::StepBegin: {
+        const auto& s = *env.payload_as_StepBegin();
+        beam.begin_step(static_cast<int>(s.step()), s.time());
+        return msg::ack(h);
+      }
+      case fb::Payload::BeamSolveRequest: {
+        const auto& r = *env.payload_as_BeamSolveRequest();
+        auto q = msg::to_vec3s(r.line_loads());
+        const std::size_t n = beam.sample_points().size();
+        if (q.size() != n)
+          throw msg::ProtocolError("BeamSolveRequest carries " + std::to_string(q.size()) +
+                                   " line loads, the stent has " + std::to_string(n) +
+                                   " sample points");
+        const auto t0 = Clock::now();
+        SolveStats stats = beam.solve(q);
+        return msg::beam_solve_reply(h, stats, seconds_since(t0), beam.sample_points());
+      }
+      case fb::Payload::StepEnd:
+        beam.end_step(env.payload_as_StepEnd()->accept());
+        return msg::ack(h);
+      default:
+        return common(env, h, stop, [&] { beam.finish(); });
+    }
+  });
+}
+
+int serve(SolidParticipant& solid, const ServeOptions& o) {
+  return serve_role(fb::Role::Solid, o, [&](const fb::Envelope& env, const msg::Header& h, bool& stop) {
+    switch (env.payload_type()) {
+      case fb::Payload::Hello:
+        return msg::hello_reply(h, o.software, nullptr);
+      case fb::Payload::StepBegin: {
+        const auto& s = *env.payload_as_StepBegin();
+        solid.begin_step(static_cast<int>(s.step()), s.time());
+        return msg::ack(h);
+      }
+      case fb::Payload::SolidSolveRequest: {
+        const auto& r = *env.payload_as_SolidSolveRequest();
+        SamplePoints pts = msg::to_sample_points(r.sample_points());
+        ContactReply reply;
+        const auto t0 = Clock::now();
+        SolveStats stats = solid.solve(pts, reply);
+        return msg::solid_solve_reply(h, stats, seconds_since(t0), reply);
+      }
+      case fb::Payload::StepEnd:
+        solid.end_step(env.payload_as_StepEnd()->accept());
+        return msg::ack(h);
+      default:
+        return common(env, h, stop, [&] { solid.finish(); });
+    }
+  });
+}
+
+}  // namespace angio::participant

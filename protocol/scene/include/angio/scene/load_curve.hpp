@@ -1,0 +1,47 @@
+// Piecewise-linear load curves of pseudo-time, declared once at the top level of a scene:
+//   load_curves:
+//     pressure: [[0.0, 0.0], [1.0, 1.317], [2.0, 0.0]]   # [t (s), value]
+// and referenced by name from loads (e.g. `curve: pressure`). Constant outside the given range.
+#pragma once
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "angio/scene/node.hpp"
+
+namespace angio::scene {
+
+class LoadCurve {
+ public:
+  LoadCurve() = default;
+  explicit LoadCurve(std::vector<std::pair<double, double>> points);  // strictly increasing t
+  static LoadCurve constant(double v) { return LoadCurve({{0.0, v}}); }
+  double value(double t) const;
+  const std::vector<std::pair<double, double>>& points() const { return points_; }
+
+ private:
+  std::vector<std::pair<double, double>> points_;
+};
+
+using LoadCurves = std::map<std::string, LoadCurve>;
+
+// Parses the top-level `load_curves:` map (absent → empty).
+LoadCurves load_curves(const Node& root);
+
+// Reads `key` of `node` as a curve name and looks it up; the error names the known curves.
+// Absent key → constant 1 (a load without a curve is applied fully at every time).
+LoadCurve curve_ref(const Node& node, const std::string& key, const LoadCurves& curves);
+
+// The `time:` section: pseudo-time interval and load steps, shared by all participants.
+struct TimeSettings {
+  double start = 0.0;
+  double end = 1.0;
+  int steps = 1;
+  double min_step = 0.0;  // smallest step the stepper may cut down to (default: initial/1024)
+  int max_cuts = 10;
+};
+TimeSettings time_settings(const Node& root);
+
+}  // namespace angio::scene

@@ -1,0 +1,77 @@
+#include "angio/scene/load_curve.hpp"
+
+#include <stdexcept>
+
+namespace angio::scene {
+
+LoadCurve::LoadCurve(std::vector<std::pair<double, double>> points) : points_(std::move(points)) {
+  if (points_.empty()) throw std::invalid_argument("LoadCurve: no points");
+  for (std::size_t i = 1; i < points_.size(); ++i)
+    if (!(points_[i].first > points_[i - 1].first))
+      throw std::invalid_argument("LoadCurve: times must increase strictly");
+}
+
+double LoadCurve::value(double t) const {
+  if (points_.empty()) return 0.0;
+  if (t <= points_.front().first) return points_.front().second;
+  if (t >= points_.back().first) return points_.back().second;
+  for (std::size_t i = 1; i < points_.size(); ++i) {
+    if (t <= points_[i].first) {
+      const auto& [t0, v0] = points_[i - 1];
+      const auto& [t1, v1] = points_[i];
+      return v0 + (v1 - v0) * (t - t0) / (t1 - t0);
+    }
+  }
+  return points_.back().second;
+}
+
+LoadCurves load_curves(const Node& root) {
+  LoadCurves out;
+  auto lc = root.optional("load_curves");
+  if (!lc) return out;
+  for (const std::string& name : lc->keys()) {
+    Node c = lc->child(name);
+    const std::string expected = "a list of [t, value] pairs with strictly increasing t";
+    if (!c.is_sequence() || c.size() == 0) c.fail(expected);
+    std::vector<std::pair<double, double>> pts;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      Node p = c.at(i);
+      if (!p.is_sequence() || p.size() != 2) p.fail("a pair [t, value]");
+      double t = p.at(0).as_number(), v = p.at(1).as_number();
+      if (!pts.empty() && !(t > pts.back().first)) p.at(0).fail("a time larger than the previous");
+      pts.emplace_back(t, v);
+    }
+    out.emplace(name, LoadCurve(std::move(pts)));
+  }
+  return out;
+}
+
+LoadCurve curve_ref(const Node& node, const std::string& key, const LoadCurves& curves) {
+  if (!node.has(key)) return LoadCurve::constant(1.0);
+  Node c = node.child(key);
+  std::string name = c.as_string();
+  auto it = curves.find(name);
+  if (it == curves.end()) {
+    std::string known;
+    for (const auto& [n, _] : curves) known += (known.empty() ? "'" : ", '") + n + "'";
+    c.fail("the name of a curve under load_curves" +
+           (known.empty() ? std::string(" (none defined)") : " (" + known + ")"));
+  }
+  return it->second;
+}
+
+TimeSettings time_settings(const Node& root) {
+  TimeSettings ts;
+  auto t = root.optional("time");
+  if (!t) return ts;
+  t->check_keys({"start", "end", "steps", "min_step", "max_cuts"});
+  ts.start = t->number_or("start", 0.0);
+  ts.end = t->number("end");
+  if (!(ts.end > ts.start)) t->child("end").fail("a time larger than time.start");
+  ts.steps = static_cast<int>(t->integer("steps", 1));
+  ts.min_step = t->positive_or("min_step", (ts.end - ts.start) / ts.steps / 1024.0);
+  ts.max_cuts = static_cast<int>(t->integer_or("max_cuts", 10, 0));
+  return ts;
+}
+
+}  // namespace angio::scene

@@ -1,0 +1,248 @@
+#include "angio/scene/node.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+namespace angio::scene {
+
+Node::Node(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+std::string Node::child_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+std::string Node::got() const {
+  if (!node_.IsDefined() || node_.IsNull()) return "nothing";
+  if (node_.IsScalar()) return "'" + node_.Scalar() + "'";
+  if (node_.IsSequence()) return "a list";
+  return "a map";
+}
+
+void Node::fail(const std::string& expected) const {
+  std::string where = path_.empty() ? "(top level)" : path_;
+  std::string msg = file_ + ": " + where + ": expected " + expected;
+  if (node_.IsDefined()) msg += ", got " + got();
+  throw SceneError(msg);
+}
+
+bool Node::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
+}
+
+Node Node::child(const std::string& key, const std::string& what) const {
+  if (!node_.IsMap()) fail("a map containing '" + key + "'");
+  if (!has(key)) throw SceneError(file_ + ": " + child_path(key) + ": missing, expected " + what);
+  return Node(node_[key], file_, child_path(key));
+}
+
+std::optional<Node> Node::optional(const std::string& key) const {
+  if (!has(key)) return std::nullopt;
+  return Node(node_[key], file_, child_path(key));
+}
+
+std::size_t Node::size() const {
+  if (!node_.IsSequence()) fail("a list");
+  return node_.size();
+}
+
+Node Node::at(std::size_t i) const {
+  if (!node_.IsSequence()) fail("a list");
+  if (i >= node_.size()) fail("at least " + std::to_string(i + 1) + " entries");
+  return Node(node_[i], file_, path_ + "[" + std::to_string(i) + "]");
+}
+
+std::vector<std::string> Node::keys() const {
+  if (!node_.IsMap()) fail("a map");
+  std::vector<std::string> out;
+  for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
+double Node::as_number() const {
+  if (!node_.IsScalar()) fail("a number");
+  // yaml-cpp accepts "nan"/".inf"; a scene value must be finite.
+  double v;
+  try {
+    v = node_.as<double>();
+  } catch (const YAML::Exception&) {
+    fail("a number");
+  }
+  if (!std::isfinite(v)) fail("a finite number");
+  return v;
+}
+
+long Node::as_integer() const {
+  if (!node_.IsScalar()) fail("an integer");
+  try {
+    return node_.as<long>();
+  } catch (const YAML::Exception&) {
+    fail("an integer");
+  }
+}
+
+std::string Node::as_string() const {
+  if (!node_.IsScalar()) fail("a string");
+  return node_.Scalar();
+}
+
+std::vector<double> Node::as_numbers() const {
+  if (!node_.IsSequence()) fail("a list of numbers");
+  std::vector<double> out;
+  for (std::size_t i = 0; i < node_.size(); ++i) out.push_back(at(i).as_number());
+  return out;
+}
+
+std::array<double, 3> Node::as_vec3() const {
+  if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 numbers [x, y, z]");
+  return {at(0).as_number(), at(1).as_number(), at(2).as_number()};
+}
+
+double Node::number(const std::string& key) const { return child(key, "a number").as_number(); }
+
+double Node::number_or(const std::string& key, double fallback) const {
+  return has(key) ? number(key) : fallback;
+}
+
+double Node::positive(const std::string& key) const {
+  Node c = child(key, "a positive number");
+  double v = c.as_number();
+  if (!(v > 0.0)) c.fail("a positive number");
+  return v;
+}
+
+double Node::positive_or(const std::string& key, double fallback) const {
+  return has(key) ? positive(key) : fallback;
+}
+
+double Node::non_negative(const std::string& key) const {
+  Node c = child(key, "a non-negative number");
+  double v = c.as_number();
+  if (!(v >= 0.0)) c.fail("a non-negative number");
+  return v;
+}
+
+double Node::non_negative_or(const std::string& key, double fallback) const {
+  return has(key) ? non_negative(key) : fallback;
+}
+
+double Node::in_range(const std::string& key, double lo, double hi) const {
+  std::ostringstream what;
+  what << "a number in [" << lo << ", " << hi << "]";
+  Node c = child(key, what.str());
+  double v = c.as_number();
+  if (v < lo || v > hi) c.fail(what.str());
+  return v;
+}
+
+long Node::integer(const std::string& key, long min) const {
+  std::string what = min == std::numeric_limits<long>::min()
+                         ? std::string("an integer")
+                         : "an integer >= " + std::to_string(min);
+  Node c = child(key, what);
+  long v = c.as_integer();
+  if (v < min) c.fail(what);
+  return v;
+}
+
+long Node::integer_or(const std::string& key, long fallback, long min) const {
+  return has(key) ? integer(key, min) : fallback;
+}
+
+bool Node::boolean(const std::string& key) const {
+  Node c = child(key, "true or false");
+  if (!c.node_.IsScalar()) c.fail("true or false");
+  try {
+    return c.node_.as<bool>();
+  } catch (const YAML::Exception&) {
+    c.fail("true or false");
+  }
+}
+
+bool Node::boolean_or(const std::string& key, bool fallback) const {
+  return has(key) ? boolean(key) : fallback;
+}
+
+std::string Node::string(const std::string& key) const {
+  return child(key, "a string").as_string();
+}
+
+std::string Node::string_or(const std::string& key, const std::string& fallback) const {
+  return has(key) ? string(key) : fallback;
+}
+
+static std::string one_of(std::initializer_list<const char*> allowed) {
+  std::string s = "one of";
+  for (const char* a : allowed) s += std::string(" '") + a + "'";
+  return s;
+}
+
+std::string Node::choice(const std::string& key, std::initializer_list<const char*> allowed) const {
+  Node c = child(key, one_of(allowed));
+  std::string v = c.as_string();
+  for (const char* a : allowed)
+    if (v == a) return v;
+  c.fail(one_of(allowed));
+}
+
+std::string Node::choice_or(const std::string& key, std::initializer_list<const char*> allowed,
+                            const std::string& fallback) const {
+  return has(key) ? choice(key, allowed) : fallback;
+}
+
+std::array<double, 3> Node::vec3(const std::string& key) const {
+  return child(key, "a list of 3 numbers [x, y, z]").as_vec3();
+}
+
+std::vector<double> Node::numbers(const std::string& key) const {
+  return child(key, "a list of numbers").as_numbers();
+}
+
+std::vector<long> Node::integers(const std::string& key) const {
+  Node c = child(key, "a list of integers");
+  std::vector<long> out;
+  for (std::size_t i = 0; i < c.size(); ++i) out.push_back(c.at(i).as_integer());
+  return out;
+}
+
+void Node::check_keys(std::initializer_list<const char*> allowed) const {
+  check_keys(std::vector<std::string>(allowed.begin(), allowed.end()));
+}
+
+void Node::check_keys(const std::vector<std::string>& allowed) const {
+  if (!node_.IsMap()) fail("a map");
+  std::set<std::string> ok(allowed.begin(), allowed.end());
+  for (const auto& kv : node_) {
+    std::string k = kv.first.as<std::string>();
+    if (!ok.count(k)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw SceneError(file_ + ": " + child_path(k) + ": unknown key, expected one of: " + list);
+    }
+  }
+}
+
+Node load_scene(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path))
+    throw SceneError(path + ": cannot open scene file (no such file)");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw SceneError(path + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) +
+                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  Node n(root, path, "");
+  if (!root.IsMap()) n.fail("a YAML map at the top level");
+  return n;
+}
+
+std::string resolve_path(const Node& node, const std::string& relative) {
+  std::filesystem::path p(relative);
+  if (p.is_absolute()) return p.string();
+  return (std::filesystem::path(node.file()).parent_path() / p).lexically_normal().string();
+}
+
+}  // namespace angio::scene

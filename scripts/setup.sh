@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs what the project needs from Debian packages, if missing (idempotent), and checks for
+# a Rust toolchain (cargo >= 1.75) to build the zenoh shim. Run as root or with sudo available.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev libsuitesparse-dev
+  petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev libhdf5-dev
+  flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev
+  libgtest-dev googletest
+  python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+else
+  echo "setup: all Debian packages present"
+fi
+
+# cargo: from rustup (~/.cargo/bin) or the system; Debian bookworm's own cargo is too old for zenoh.
+export PATH="$HOME/.cargo/bin:$PATH"
+if ! command -v cargo >/dev/null 2>&1; then
+  echo "setup: error: cargo not found. The zenoh transport is a Rust crate built with cargo >= 1.75;" >&2
+  echo "       install a Rust toolchain (e.g. rustup) and re-run." >&2
+  exit 1
+fi
+v=$(cargo --version | awk '{print $2}')
+major=${v%%.*}; rest=${v#*.}; minor=${rest%%.*}
+if [ "$major" -lt 1 ] || { [ "$major" -eq 1 ] && [ "$minor" -lt 75 ]; }; then
+  echo "setup: error: cargo $v is too old; the zenoh crate needs cargo >= 1.75 (found $(command -v cargo))" >&2
+  exit 1
+fi
+echo "setup: cargo $v"

@@ -1,0 +1,86 @@
+// In-process participants with an analytic coupled solution, for testing the coupling loop
+// without processes: every sample point is a radial spring (stiffness kb per unit length) on the
+// beam side, pushed by a rigid wall on the solid side that sits at radius s(t) and acts by penalty
+// (eps): q~ = eps·max(s − x − R, 0) outward. Coupled fixed point, for contact:
+//   q = eps (s − x0 − R − q/kb)  ⇒  q* = eps (s − x0 − R) / (1 + eps/kb).
+// Gauss–Seidel without relaxation amplifies errors by −eps/kb: it diverges for eps > kb.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "angio/participant/beam_participant.hpp"
+#include "angio/participant/solid_participant.hpp"
+
+namespace angio::test {
+
+using participant::Vec3;
+
+struct SpringBeam : participant::BeamParticipant {
+  int n = 4;
+  double kb = 1.0, x0 = 1.0, R = 0.05;
+  std::vector<double> x, x_committed;
+  int fail_at_step = -1;  // Newton "fails" at this step once (tests step cutting)
+  int step = 0, accepted = 0, rejected = 0;
+  bool failed_once = false;
+
+  SpringBeam() : x(n, x0), x_committed(n, x0) {}
+  participant::SamplePoints sample_points() const override {
+    participant::SamplePoints p;
+    for (int i = 0; i < n; ++i) {
+      p.x.push_back({x[i], 0.0, 0.1 * i});
+      p.w.push_back(0.1);
+      p.radius.push_back(R);
+    }
+    return p;
+  }
+  void begin_step(int s, double) override { step = s; }
+  participant::SolveStats solve(const std::vector<Vec3>& q) override {
+    participant::SolveStats st;
+    if (step == fail_at_step && !failed_once) {
+      failed_once = true;
+      st.converged = false;
+      st.message = "injected failure";
+      return st;
+    }
+    for (int i = 0; i < n; ++i) x[i] = x0 + q[i][0] / kb;
+    st.converged = true;
+    st.iterations = 1;
+    return st;
+  }
+  void end_step(bool accept) override {
+    if (accept) {
+      x_committed = x;
+      ++accepted;
+    } else {
+      x = x_committed;
+      ++rejected;
+    }
+  }
+  void finish() override {}
+};
+
+struct WallSolid : participant::SolidParticipant {
+  double eps = 10.0;
+  double s_max = 1.5;  // wall radius at t = 1 (linear ramp s = x0 + (s_max − x0)·t)
+  double x0 = 1.0;
+  double s = 1.0;
+  void begin_step(int, double t) override { s = x0 + (s_max - x0) * t; }
+  participant::SolveStats solve(const participant::SamplePoints& p,
+                                participant::ContactReply& reply) override {
+    reply = {};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double g = s - p.x[i][0] - p.radius[i];
+      const double q = eps * std::max(g, 0.0);
+      reply.line_loads.push_back({q, 0.0, 0.0});
+      if (g > 0) ++reply.n_active;
+    }
+    participant::SolveStats st;
+    st.converged = true;
+    return st;
+  }
+  void end_step(bool) override {}
+  void finish() override {}
+};
+
+}  // namespace angio::test

@@ -1,0 +1,98 @@
+// Scene loading: values are read with their key path, and every bad input gives an error that
+// names the file, the key path and what was expected (issue 2, item 5).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "angio/scene/load_curve.hpp"
+#include "angio/scene/node.hpp"
+
+using namespace angio::scene;
+
+namespace {
+const std::string kGood = std::string(ANGIO_TEST_DATA) + "/good.yaml";
+
+Node inline_scene(const std::string& text) {
+  return Node(YAML::Load(text), "inline.yaml", "");
+}
+
+// Runs f, expects a SceneError whose message contains every fragment.
+template <class F>
+void expect_error(F f, std::initializer_list<std::string> fragments) {
+  try {
+    f();
+    FAIL() << "no SceneError thrown";
+  } catch (const SceneError& e) {
+    for (const auto& s : fragments)
+      EXPECT_NE(std::string(e.what()).find(s), std::string::npos) << e.what() << " lacks " << s;
+  }
+}
+}  // namespace
+
+TEST(Scene, ReadsValuesWithPaths) {
+  Node root = load_scene(kGood);
+  EXPECT_DOUBLE_EQ(root.child("stent").child("material").positive("E"), 380000.0);
+  EXPECT_EQ(root.child("stent").integer("rings", 1), 4);
+  auto c = root.child("stent").vec3("center");
+  EXPECT_DOUBLE_EQ(c[2], 1.5);
+  EXPECT_EQ(root.child("stent").child("material").path(), "stent.material");
+  EXPECT_DOUBLE_EQ(root.child("stent").number_or("missing", 7.0), 7.0);
+}
+
+TEST(Scene, MissingFileAndSyntaxErrors) {
+  expect_error([] { load_scene("/nonexistent/scene.yaml"); }, {"/nonexistent/scene.yaml", "no such file"});
+  expect_error([] { load_scene(std::string(ANGIO_TEST_DATA) + "/syntax_error.yaml"); },
+               {"syntax_error.yaml", "line"});
+}
+
+TEST(Scene, ErrorsNameFileKeyAndExpectation) {
+  Node n = inline_scene("stent: {material: {E: -3, nu: abc}, rings: 2.5, kind: tube, v: [1, 2]}");
+  Node m = n.child("stent").child("material");
+  expect_error([&] { m.positive("E"); }, {"inline.yaml", "stent.material.E", "positive", "'-3'"});
+  expect_error([&] { m.number("nu"); }, {"stent.material.nu", "a number", "'abc'"});
+  expect_error([&] { m.number("G"); }, {"stent.material.G", "missing"});
+  expect_error([&] { n.child("stent").integer("rings"); }, {"stent.rings", "integer"});
+  expect_error([&] { n.child("stent").choice("kind", {"corrugated_rings", "explicit"}); },
+               {"stent.kind", "'corrugated_rings'", "'tube'"});
+  expect_error([&] { n.child("stent").vec3("v"); }, {"stent.v", "3 numbers"});
+  expect_error([&] { n.child("stent").check_keys({"material", "rings", "kind"}); },
+               {"stent.v", "unknown key"});
+}
+
+TEST(Scene, NonFiniteNumbersAreRejected) {
+  Node n = inline_scene("a: .nan\nb: .inf\n");
+  expect_error([&] { n.number("a"); }, {"a", "finite"});
+  expect_error([&] { n.number("b"); }, {"b", "finite"});
+}
+
+TEST(Scene, LoadCurvesInterpolateLinearly) {
+  Node root = load_scene(kGood);
+  LoadCurves curves = load_curves(root);
+  const LoadCurve& p = curves.at("pressure");
+  EXPECT_DOUBLE_EQ(p.value(0.5), 0.6585);
+  EXPECT_DOUBLE_EQ(p.value(1.0), 1.317);
+  EXPECT_DOUBLE_EQ(p.value(1.5), 0.6585);
+  EXPECT_DOUBLE_EQ(p.value(3.0), 0.0);  // constant beyond the last point
+  LoadCurve ref = curve_ref(root.child("stent").child("pressure"), "curve", curves);
+  EXPECT_DOUBLE_EQ(ref.value(1.0), 1.317);
+}
+
+TEST(Scene, BadLoadCurvesAreRejected) {
+  expect_error([] { load_curves(inline_scene("load_curves: {p: [[0, 0], [0, 1]]}")); },
+               {"load_curves.p[1][0]", "larger than the previous"});
+  expect_error([] { load_curves(inline_scene("load_curves: {p: [[0, 0, 1]]}")); },
+               {"load_curves.p[0]", "pair"});
+  Node n = inline_scene("load_curves: {p: [[0, 0]]}\nload: {curve: q}");
+  expect_error([&] { curve_ref(n.child("load"), "curve", load_curves(n)); },
+               {"load.curve", "'p'", "'q'"});
+}
+
+TEST(Scene, TimeSettings) {
+  TimeSettings t = time_settings(load_scene(kGood));
+  EXPECT_DOUBLE_EQ(t.end, 2.0);
+  EXPECT_EQ(t.steps, 100);
+  EXPECT_DOUBLE_EQ(t.min_step, 0.02 / 1024.0);
+  expect_error([] { time_settings(inline_scene("time: {end: 1, steps: 0}")); }, {"time.steps", ">= 1"});
+  expect_error([] { time_settings(inline_scene("time: {start: 2, end: 1, steps: 3}")); }, {"time.end"});
+}
