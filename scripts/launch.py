@@ -179,7 +179,11 @@ def main():
     signal.signal(signal.SIGTERM, forward)
     t0 = time.time()
     for name, cmd in plan:
-        procs.append(Proc(name, cmd, run_dir / f"{name}.log"))
+        try:
+            procs.append(Proc(name, cmd, run_dir / f"{name}.log"))
+        except OSError as e:
+            stop_all(procs)
+            die(f"cannot start {name} ({' '.join(cmd[:1])}): {e.strerror}", code=10 + len(procs))
 
     failed = None
     while True:

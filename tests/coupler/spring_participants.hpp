@@ -73,6 +73,7 @@ struct WallSolid : participant::SolidParticipant {
       const double g = s - p.x[i][0] - p.radius[i];
       const double q = eps * std::max(g, 0.0);
       reply.line_loads.push_back({q, 0.0, 0.0});
+      reply.total_force[0] += p.w[i] * q;
       if (g > 0) ++reply.n_active;
     }
     participant::SolveStats st;

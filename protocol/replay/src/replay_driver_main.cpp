@@ -1,0 +1,103 @@
+// replay_driver: plays the coupler for ONE real participant. It sends the recorded requests of
+// that role verbatim and compares the participant's replies with the recorded replies within a
+// tolerance (the check that a solver still reproduces a recorded co-simulation).
+#include <chrono>
+#include <cmath>
+#include <iostream>
+
+#include "angio/common/cli.hpp"
+#include "angio/common/log.hpp"
+#include "angio/messages/convert.hpp"
+#include "angio/participant/keys.hpp"
+#include "angio/replay/replay_participants.hpp"
+#include "angio/transport.hpp"
+
+using namespace angio;
+
+namespace {
+
+std::string verb_of(fb::Payload p) {
+  switch (p) {
+    case fb::Payload::Hello: return "hello";
+    case fb::Payload::StepBegin: return "step_begin";
+    case fb::Payload::BeamSolveRequest:
+    case fb::Payload::SolidSolveRequest: return "solve";
+    case fb::Payload::StepEnd: return "step_end";
+    case fb::Payload::Shutdown: return "shutdown";
+    default: return "unknown";
+  }
+}
+
+// Relative deviation of a live reply from the recorded one, on the interface vectors the
+// coupler consumes; throws if the kind of reply differs.
+double deviation(const fb::Envelope& live, const fb::Envelope& rec) {
+  if (live.payload_type() != rec.payload_type())
+    throw replay::ReplayMismatch(std::string("reply is a ") + msg::payload_name(live.payload_type()) +
+                                 ", recorded a " + msg::payload_name(rec.payload_type()));
+  if (auto* b = live.payload_as_BeamSolveReply()) {
+    auto* r = rec.payload_as_BeamSolveReply();
+    if (b->stats()->converged() != r->stats()->converged())
+      throw replay::ReplayMismatch("Newton convergence differs from the recording");
+    return replay::relative_difference(msg::to_sample_points(b->sample_points()).x,
+                                       msg::to_sample_points(r->sample_points()).x);
+  }
+  if (auto* s = live.payload_as_SolidSolveReply()) {
+    auto* r = rec.payload_as_SolidSolveReply();
+    if (s->stats()->converged() != r->stats()->converged())
+      throw replay::ReplayMismatch("Newton convergence differs from the recording");
+    return replay::relative_difference(msg::to_vec3s(s->line_loads()), msg::to_vec3s(r->line_loads()));
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cli::Parser args("replay_driver",
+                   "Drives one real participant with the recorded requests of its role and\n"
+                   "compares its replies with the recorded ones.");
+  args.add({"recording", "FILE", "recording written by the coupler (--record)", ""});
+  args.add({"role", "ROLE", "beam or solid", ""});
+  args.add({"tolerance", "REL", "relative tolerance on interface vectors", "1e-6"});
+  args.add_common();
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    cli::setup_logging(args, "replay-driver");
+    const std::string role = args.get("role");
+    const fb::Role r = role == "beam" ? fb::Role::Beam : role == "solid" ? fb::Role::Solid
+                       : throw cli::UsageError("--role: expected beam or solid, got '" + role + "'");
+    const auto rec = recording::read(args.get("recording"));
+    const double tol = args.number("tolerance");
+    const auto timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
+    auto session = transport::Session::open({{args.get("endpoint")}, {}});
+    auto token = session.declare_liveliness_token(participant::keys::alive(rec.run_id, "coupler"));
+    double worst = 0.0;
+    std::size_t n = 0;
+    for (const auto& e : rec.exchanges) {
+      if (e.role != r) continue;
+      const fb::Envelope& req = msg::open(e.request, rec.run_id);
+      const std::string key = participant::keys::request(rec.run_id, role, verb_of(req.payload_type()));
+      const auto live_bytes = session.request(key, e.request, timeout);
+      const fb::Envelope& live = msg::open(live_bytes, rec.run_id);
+      if (const auto* err = live.payload_as_Error())
+        throw replay::ReplayMismatch("exchange " + std::to_string(n) + ": participant error: " +
+                                     flatbuffers::GetString(err->message()));
+      const double d = deviation(live, msg::open(e.reply, rec.run_id));
+      worst = std::max(worst, d);
+      if (!(d <= tol))
+        throw replay::ReplayMismatch("exchange " + std::to_string(n) + " (" + verb_of(req.payload_type()) +
+                                     "): reply deviates by " + std::to_string(d) +
+                                     " (relative), tolerance " + std::to_string(tol));
+      ++n;
+    }
+    LOG_INFO(n << " exchanges replayed against the " << role << " participant; largest relative deviation "
+               << worst << " (tolerance " << tol << ")");
+    return 0;
+  } catch (const cli::UsageError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    LOG_ERROR(e.what());
+    return 1;
+  }
+}

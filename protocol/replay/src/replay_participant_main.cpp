@@ -1,0 +1,46 @@
+// replay_participant: plays the beam or the solid role from a recording, so the coupler can be
+// tested without real solvers; every request it receives is checked against the recorded one.
+#include <chrono>
+
+#include "angio/common/cli.hpp"
+#include "angio/common/log.hpp"
+#include "angio/participant/role_server.hpp"
+#include "angio/replay/replay_participants.hpp"
+
+using namespace angio;
+
+int main(int argc, char** argv) {
+  cli::Parser args("replay_participant",
+                   "Answers the coupler's requests for one role from a recording (see\n"
+                   "scripts/make_recordings.sh), checking each request against the recorded one.");
+  args.add({"recording", "FILE", "recording written by the coupler (--record)", ""});
+  args.add({"role", "ROLE", "beam or solid", ""});
+  args.add({"tolerance", "REL", "relative tolerance on interface vectors", "1e-9"});
+  args.add_common();
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    const std::string role = args.get("role");
+    cli::setup_logging(args, "replay-" + role);
+    if (role != "beam" && role != "solid")
+      throw cli::UsageError("--role: expected beam or solid, got '" + role + "'");
+    const auto rec = recording::read(args.get("recording"));
+    participant::ServeOptions o;
+    o.endpoint = args.get("endpoint");
+    o.run_id = args.has("run-id") ? args.get("run-id") : rec.run_id;
+    o.timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
+    o.software = "replay_participant (" + args.get("recording") + ")";
+    const double tol = args.number("tolerance");
+    if (role == "beam") {
+      replay::ReplayBeam beam(rec, tol);
+      return participant::serve(beam, o);
+    }
+    replay::ReplaySolid solid(rec, tol);
+    return participant::serve(solid, o);
+  } catch (const cli::UsageError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    LOG_ERROR(e.what());
+    return 1;
+  }
+}

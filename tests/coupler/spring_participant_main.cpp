@@ -1,0 +1,34 @@
+// Test participant: serves the spring beam or the rigid-wall solid of spring_participants.hpp
+// over zenoh, so the coupler, the transport and the launcher can be tested end to end against a
+// problem with an analytic solution, independently of the real solvers.
+#include "angio/common/cli.hpp"
+#include "angio/common/log.hpp"
+#include "angio/participant/role_server.hpp"
+#include "spring_participants.hpp"
+
+using namespace angio;
+
+int main(int argc, char** argv) {
+  cli::Parser args("spring_participant", "Test participant with an analytic coupled solution.");
+  args.add({"role", "ROLE", "beam or solid", ""});
+  args.add_common();
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    const std::string role = args.get("role");
+    cli::setup_logging(args, "spring-" + role);
+    participant::ServeOptions o;
+    o.endpoint = args.get("endpoint");
+    o.run_id = args.get("run-id");
+    o.timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
+    o.software = "spring_participant";
+    if (role == "beam") {
+      test::SpringBeam beam;
+      return participant::serve(beam, o);
+    }
+    test::WallSolid wall;
+    return participant::serve(wall, o);
+  } catch (const std::exception& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  }
+}
