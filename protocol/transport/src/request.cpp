@@ -1,0 +1,75 @@
+// Session::request / request_once: the requesting side of request/reply.
+#include <algorithm>
+#include <thread>
+
+#include "angio/transport/errors.hpp"
+#include "angio/transport/owned_buffer.hpp"
+#include "angio/transport/session.hpp"
+#include "ffi.hpp"
+
+namespace angio::transport {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+// How long to wait before re-sending a request that found no queryable: short enough that a
+// peer coming up is noticed quickly, long enough not to spin on a loaded machine.
+constexpr milliseconds no_route_backoff{20};
+
+std::string timeout_message(const std::string& key, milliseconds timeout, bool route_seen) {
+  return "request to '" + key + "' got no reply within " + std::to_string(timeout.count()) +
+         " ms (" + (route_seen ? "the queryable did not answer in time" : "no queryable reachable on this key") +
+         ")";
+}
+
+// One az_request call; returns the status and fills `reply` on AZ_OK.
+int attempt(az_session* s, const std::string& key, ByteView payload, milliseconds timeout,
+            OwnedBuffer& reply) {
+  az_bytes raw{nullptr, 0};
+  const int rc = az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(timeout), &raw);
+  reply = OwnedBuffer::adopt(raw);
+  return rc;
+}
+
+}  // namespace
+
+Bytes Session::request_once(const std::string& key, ByteView payload, milliseconds timeout) const {
+  OwnedBuffer reply;
+  const int rc = attempt(checked(), key, payload, timeout, reply);
+  switch (rc) {
+    case AZ_OK:
+      return reply.to_vector();
+    case AZ_TIMEOUT:
+      throw TimeoutError(timeout_message(key, timeout, true));
+    case AZ_NO_REPLY:
+      throw NoReplyError("request to '" + key + "' finished without reply (no queryable reachable)");
+    default:
+      detail::throw_status(rc, "request to '" + key + "'");
+  }
+}
+
+Bytes Session::request(const std::string& key, ByteView payload, milliseconds timeout) const {
+  const auto deadline = Clock::now() + detail::clamp_timeout(timeout);
+  OwnedBuffer reply;
+  for (;;) {
+    const auto remaining = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
+    if (remaining <= milliseconds::zero()) throw TimeoutError(timeout_message(key, timeout, false));
+    const int rc = attempt(checked(), key, payload, remaining, reply);
+    switch (rc) {
+      case AZ_OK:
+        return reply.to_vector();
+      case AZ_TIMEOUT:
+        throw TimeoutError(timeout_message(key, timeout, true));
+      case AZ_NO_REPLY:
+        // No queryable known yet (peer still connecting or not started): try again.
+        std::this_thread::sleep_for(std::min(no_route_backoff, remaining));
+        break;
+      default:
+        detail::throw_status(rc, "request to '" + key + "'");
+    }
+  }
+}
+
+}  // namespace angio::transport

@@ -1,0 +1,209 @@
+//! Request/reply: queryables delivering incoming queries to a FIFO, and requests (get).
+
+use std::ffi::{c_char, c_int, CString};
+use std::time::Instant;
+
+use zenoh::handlers::FifoChannelHandler;
+use zenoh::query::{ConsolidationMode, Query, Queryable, Reply};
+use zenoh::Wait;
+
+use crate::ffi::*;
+use crate::session::az_session;
+
+// ---------------------------------------------------------------------------------------------
+// Queryable / incoming queries
+// ---------------------------------------------------------------------------------------------
+
+pub struct az_queryable {
+    queryable: Queryable<FifoChannelHandler<Query>>,
+}
+
+pub struct az_query {
+    query: Query,
+    key: CString,
+}
+
+/// Declares a queryable on `keyexpr`; incoming queries queue in a FIFO until `az_queryable_recv`.
+#[no_mangle]
+pub unsafe extern "C" fn az_queryable_declare(
+    s: *const az_session,
+    keyexpr: *const c_char,
+    out: *mut *mut az_queryable,
+) -> c_int {
+    guard(|| {
+        let out = out_ptr(out, "queryable")?;
+        *out = std::ptr::null_mut();
+        let s = handle(s, "session")?;
+        let key = str_arg(keyexpr, "keyexpr")?;
+        let queryable = s
+            .session
+            .declare_queryable(key.to_string())
+            .wait()
+            .map_err(|e| Fail::err(format!("cannot declare queryable on '{key}': {e}")))?;
+        *out = Box::into_raw(Box::new(az_queryable { queryable }));
+        Ok(AZ_OK)
+    })
+}
+
+/// Undeclares the queryable and frees it. Queries already received stay valid. NULL is a no-op.
+#[no_mangle]
+pub unsafe extern "C" fn az_queryable_drop(q: *mut az_queryable) {
+    guard_void(|| {
+        if !q.is_null() {
+            let q = Box::from_raw(q);
+            let _ = q.queryable.undeclare().wait();
+        }
+    })
+}
+
+/// Waits up to `timeout_ms` for the next query. On AZ_OK, `*out_query` is a new handle
+/// (free it with az_query_reply / az_query_reply_err / az_query_drop) and `*out_payload` holds
+/// the request payload (free with az_bytes_free; may be {NULL,0}). AZ_TIMEOUT: nothing arrived.
+#[no_mangle]
+pub unsafe extern "C" fn az_queryable_recv(
+    q: *const az_queryable,
+    timeout_ms: u64,
+    out_query: *mut *mut az_query,
+    out_payload: *mut az_bytes,
+) -> c_int {
+    guard(|| {
+        let out_query = out_ptr(out_query, "query")?;
+        *out_query = std::ptr::null_mut();
+        let out_payload = out_ptr(out_payload, "payload")?;
+        *out_payload = az_bytes::empty();
+        let q = handle(q, "queryable")?;
+        match q.queryable.handler().recv_timeout(ms(timeout_ms)) {
+            Ok(Some(query)) => {
+                let payload = query.payload().map(zbytes_to_vec).unwrap_or_default();
+                let key = CString::new(query.key_expr().as_str()).unwrap_or_default();
+                *out_payload = az_bytes::from_vec(payload);
+                *out_query = Box::into_raw(Box::new(az_query { query, key }));
+                Ok(AZ_OK)
+            }
+            Ok(None) => Ok(AZ_TIMEOUT),
+            Err(e) => Err(Fail(
+                AZ_ERR_DISCONNECTED,
+                format!("queryable '{}' channel closed: {e}", q.queryable.key_expr()),
+            )),
+        }
+    })
+}
+
+/// Key expression of the query; valid while the query handle lives.
+#[no_mangle]
+pub unsafe extern "C" fn az_query_keyexpr(q: *const az_query) -> *const c_char {
+    match q.as_ref() {
+        Some(q) => q.key.as_ptr(),
+        None => std::ptr::null(),
+    }
+}
+
+/// Sends `data` as the reply and frees the query handle (always, even on error).
+#[no_mangle]
+pub unsafe extern "C" fn az_query_reply(q: *mut az_query, data: *const u8, len: usize) -> c_int {
+    guard(|| {
+        if q.is_null() {
+            return Err(Fail::arg("query handle is NULL"));
+        }
+        let q = Box::from_raw(q);
+        let bytes = bytes_arg(data, len)?.to_vec();
+        let key = q.query.key_expr().clone();
+        q.query
+            .reply(key.clone(), bytes)
+            .wait()
+            .map_err(|e| Fail::err(format!("cannot reply to query on '{key}': {e}")))?;
+        Ok(AZ_OK)
+    })
+}
+
+/// Sends an error reply (e.g. a UTF-8 message) and frees the query handle (always).
+/// The requester sees AZ_ERR_REPLY with this message as its last error.
+#[no_mangle]
+pub unsafe extern "C" fn az_query_reply_err(
+    q: *mut az_query,
+    data: *const u8,
+    len: usize,
+) -> c_int {
+    guard(|| {
+        if q.is_null() {
+            return Err(Fail::arg("query handle is NULL"));
+        }
+        let q = Box::from_raw(q);
+        let bytes = bytes_arg(data, len)?.to_vec();
+        let key = q.query.key_expr().clone();
+        q.query
+            .reply_err(bytes)
+            .wait()
+            .map_err(|e| Fail::err(format!("cannot send error reply to query on '{key}': {e}")))?;
+        Ok(AZ_OK)
+    })
+}
+
+/// Frees a query without replying; the requester then gets AZ_NO_REPLY. NULL is a no-op.
+#[no_mangle]
+pub unsafe extern "C" fn az_query_drop(q: *mut az_query) {
+    guard_void(|| {
+        if !q.is_null() {
+            drop(Box::from_raw(q));
+        }
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Request (get)
+// ---------------------------------------------------------------------------------------------
+
+/// Sends `data` to the queryable(s) on `keyexpr` and waits up to `timeout_ms` for the first
+/// reply. AZ_OK: `*out_reply` holds it (free with az_bytes_free). AZ_TIMEOUT: nothing within the
+/// timeout. AZ_NO_REPLY: the query completed with no reply (typically: no matching queryable
+/// reachable right now). AZ_ERR_REPLY: the replier sent an error (message in az_last_error).
+#[no_mangle]
+pub unsafe extern "C" fn az_request(
+    s: *const az_session,
+    keyexpr: *const c_char,
+    data: *const u8,
+    len: usize,
+    timeout_ms: u64,
+    out_reply: *mut az_bytes,
+) -> c_int {
+    guard(|| {
+        let out_reply = out_ptr(out_reply, "reply")?;
+        *out_reply = az_bytes::empty();
+        let s = handle(s, "session")?;
+        let key = str_arg(keyexpr, "keyexpr")?;
+        let payload = bytes_arg(data, len)?.to_vec();
+        let deadline = Instant::now() + ms(timeout_ms);
+        // ConsolidationMode::None hands the reply over as soon as it arrives instead of waiting
+        // for the query to be finalised.
+        let replies = s
+            .session
+            .get(key.to_string())
+            .payload(payload)
+            .consolidation(ConsolidationMode::None)
+            .timeout(ms(timeout_ms) + ZENOH_QUERY_TIMEOUT_GRACE)
+            .wait()
+            .map_err(|e| Fail::err(format!("cannot send request to '{key}': {e}")))?;
+        match replies.recv_deadline(deadline) {
+            Ok(Some(reply)) => reply_to_status(reply, key, out_reply),
+            Ok(None) => Ok(AZ_TIMEOUT),
+            // Channel closed without any reply: zenoh finalised the query (no route / no answer).
+            Err(_) => Ok(AZ_NO_REPLY),
+        }
+    })
+}
+
+fn reply_to_status(reply: Reply, key: &str, out: &mut az_bytes) -> Result<c_int, Fail> {
+    match reply.result() {
+        Ok(sample) => {
+            *out = az_bytes::from_vec(zbytes_to_vec(sample.payload()));
+            Ok(AZ_OK)
+        }
+        Err(err) => {
+            let msg = String::from_utf8_lossy(&zbytes_to_vec(err.payload())).into_owned();
+            Err(Fail(
+                AZ_ERR_REPLY,
+                format!("error reply from '{key}': {msg}"),
+            ))
+        }
+    }
+}
