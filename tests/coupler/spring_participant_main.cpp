@@ -1,6 +1,8 @@
 // Test participant: serves the spring beam or the rigid-wall solid of spring_participants.hpp
 // over zenoh, so the coupler, the transport and the launcher can be tested end to end against a
 // problem with an analytic solution, independently of the real solvers.
+#include <chrono>
+
 #include "angio/common/cli.hpp"
 #include "angio/common/log.hpp"
 #include "angio/participant/role_server.hpp"
@@ -11,6 +13,7 @@ using namespace angio;
 int main(int argc, char** argv) {
   cli::Parser args("spring_participant", "Test participant with an analytic coupled solution.");
   args.add({"role", "ROLE", "beam or solid", ""});
+  args.add({"delay", "SECONDS", "sleep this long in every solve (to test interruption)", "0"});
   args.add_common();
   try {
     if (!args.parse(argc, argv)) return 0;
@@ -21,8 +24,10 @@ int main(int argc, char** argv) {
     o.run_id = args.get("run-id");
     o.timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
     o.software = "spring_participant";
+    const double delay = args.number("delay");
     if (role == "beam") {
       test::SpringBeam beam;
+      beam.delay = delay;
       return participant::serve(beam, o);
     }
     test::WallSolid wall;

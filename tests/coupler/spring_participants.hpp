@@ -7,7 +7,9 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "angio/participant/beam_participant.hpp"
 #include "angio/participant/solid_participant.hpp"
@@ -21,6 +23,7 @@ struct SpringBeam : participant::BeamParticipant {
   double kb = 1.0, x0 = 1.0, R = 0.05;
   std::vector<double> x, x_committed;
   int fail_at_step = -1;  // Newton "fails" at this step once (tests step cutting)
+  double delay = 0.0;     // s of sleep per solve (tests interruption of a running job)
   int step = 0, accepted = 0, rejected = 0;
   bool failed_once = false;
 
@@ -37,6 +40,7 @@ struct SpringBeam : participant::BeamParticipant {
   void begin_step(int s, double) override { step = s; }
   participant::SolveStats solve(const std::vector<Vec3>& q) override {
     participant::SolveStats st;
+    if (delay > 0) std::this_thread::sleep_for(std::chrono::duration<double>(delay));
     if (step == fail_at_step && !failed_once) {
       failed_once = true;
       st.converged = false;

@@ -9,6 +9,7 @@
 4. a coupler without participants fails with a timeout error instead of hanging.
 """
 import csv
+import signal
 import subprocess
 import sys
 import tempfile
@@ -73,6 +74,22 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r3.returncode != 0 and "beam_solver exited with code 1" in r3.stderr,
           f"launcher names the failed participant (rc {r3.returncode}): {r3.stderr.strip()}")
     check(time.time() - t0 < 60, "and does not wait for the peers' timeout")
+
+    # 3b. Ctrl-C reaches every process: the launcher exits 130 and leaves no process behind
+    cmd = LAUNCH + [str(SCENE), "--run-dir", str(tmp / "interrupted"), "--build-dir", str(BIN.parent),
+                    "--run-id", "interrupt-me",
+                    "--beam-cmd", f"{spring} --role beam --delay 0.5", "--solid-cmd", f"{spring} --role solid"]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)
+    p.send_signal(signal.SIGINT)
+    try:
+        _, err = p.communicate(timeout=30)
+        check(p.returncode == 130, f"interrupted launcher exits 130 (got {p.returncode}): {err.strip()[-300:]}")
+    except subprocess.TimeoutExpired:
+        p.kill()
+        check(False, "interrupted launcher ends within 30 s")
+    left = subprocess.run(["pgrep", "-f", "interrupt-me"], capture_output=True, text=True).stdout.split()
+    check(not left, f"no process of the interrupted run is left ({left})")
 
     # 4. no participants: the coupler times out with a clear error
     t0 = time.time()

@@ -1,0 +1,104 @@
+#!/usr/bin/python3
+"""Summarize a finished run directory: results table on stdout, results.json, PNG plots.
+
+  python3 scripts/report.py RUN_DIR
+
+Reads what the run produced (beam/summary.json, solid/summary.json, coupling.csv,
+coupling_summary.json); parts that a scene did not have are skipped. Units: mm, N, MPa, s.
+"""
+import csv
+import json
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+# Paper values (DESIGN §4) for the straight free expansion, shown next to ours.
+PAPER = {"diameter_initial": 1.15, "diameter_max": 2.59, "diameter_final": 2.31,
+         "recoil": 0.28, "recoil_percent": 10.8}
+
+
+def load_json(p):
+    try:
+        with open(p) as f:
+            return json.load(f)
+    except (OSError, json.JSONDecodeError):
+        return None
+
+
+def main(run_dir):
+    run = Path(run_dir)
+    out = {}
+    rows = []
+    beam = load_json(run / "beam" / "summary.json")
+    solid = load_json(run / "solid" / "summary.json")
+    coupling = load_json(run / "coupling_summary.json")
+    steps_csv = []
+    if (run / "coupling.csv").is_file():
+        with open(run / "coupling.csv") as f:
+            steps_csv = list(csv.DictReader(f))
+
+    if beam:
+        d = beam["diameter"]
+        out["stent"] = d
+        rows += [("stent diameter crimped (mm)", d["initial"], PAPER["diameter_initial"]),
+                 ("stent diameter max (mm)", d["max"], PAPER["diameter_max"]),
+                 ("stent diameter final (mm)", d["final"], PAPER["diameter_final"]),
+                 ("elastic recoil (mm)", d["recoil"], PAPER["recoil"]),
+                 ("elastic recoil (%)", d["recoil_percent"], PAPER["recoil_percent"])]
+    if solid:
+        out["solid"] = {k: v for k, v in solid.items() if k != "steps"}
+        for k, v in solid.items():
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                rows.append((f"solid {k}", v, None))
+    if coupling:
+        out["coupling"] = coupling
+        rows += [("load steps", coupling["steps"], None),
+                 ("coupling iterations mean / max",
+                  f'{coupling["coupling_iterations_mean"]:.2f} / {coupling["coupling_iterations_max"]}', None),
+                 ("wall time (s)", coupling["wall_time"], None),
+                 ("messaging share (%)", 100 * coupling["messaging_share"], None)]
+
+    if rows:
+        w = max(len(r[0]) for r in rows)
+        print(f"{'quantity'.ljust(w)}  {'this run':>12}  {'paper':>8}")
+        for name, ours, paper in rows:
+            o = f"{ours:12.4g}" if isinstance(ours, (int, float)) else f"{ours:>12}"
+            p = f"{paper:8.4g}" if isinstance(paper, (int, float)) else f"{'':>8}"
+            print(f"{name.ljust(w)}  {o}  {p}")
+    (run / "results.json").write_text(json.dumps(out, indent=2))
+
+    if beam and beam.get("steps"):
+        t = [0.0] + [s["time"] for s in beam["steps"]]
+        D = [beam["diameter"]["initial"]] + [s["diameter"] for s in beam["steps"]]
+        fig, ax = plt.subplots(figsize=(6, 4))
+        ax.plot(t, D, "o-", ms=3)
+        ax.set_xlabel("pseudo-time t (s)")
+        ax.set_ylabel("stent diameter (mm)")
+        ax.grid(True, alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(run / "diameter_vs_time.png", dpi=120)
+        plt.close(fig)
+        if steps_csv:
+            p_of_t = {round(float(r["time"]), 9): float(r["pressure"]) for r in steps_csv}
+            pts = [(p_of_t[round(s["time"], 9)] / 0.101325, s["diameter"]) for s in beam["steps"]
+                   if round(s["time"], 9) in p_of_t]
+            if pts:
+                fig, ax = plt.subplots(figsize=(6, 4))
+                ax.plot([p for p, _ in pts], [d for _, d in pts], "o-", ms=3)
+                ax.set_xlabel("balloon pressure (atm)")
+                ax.set_ylabel("stent diameter (mm)")
+                ax.grid(True, alpha=0.3)
+                fig.tight_layout()
+                fig.savefig(run / "diameter_vs_pressure.png", dpi=120)
+                plt.close(fig)
+    print(f"report: {run / 'results.json'}" + (" and plots" if beam else ""))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
