@@ -1,0 +1,59 @@
+// Output of the beam side in <run-dir>/beam/: beam.h5 (one group per committed output step),
+// beam.xdmf (ParaView: stent polyline with node and element fields + contact sample points),
+// summary.json (final node positions, diameter per step, max/final diameter, recoil).
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "angio/beam/model.hpp"
+
+namespace angio::beam {
+
+class BeamOutput {
+ public:
+  explicit BeamOutput(const std::string& dir);  // creates dir, opens beam.h5
+  ~BeamOutput();
+  BeamOutput(const BeamOutput&) = delete;
+  BeamOutput& operator=(const BeamOutput&) = delete;
+
+  void write_step(const BeamModel& m, int step, double time);
+  void close();
+  const std::string& dir() const { return dir_; }
+
+ private:
+  void write_xdmf() const;
+  std::string dir_;
+  long file_ = -1;
+  struct StepInfo {
+    int step;
+    double time;
+    std::string group;
+  };
+  std::vector<StepInfo> steps_;
+  int nn_ = 0, ne_ = 0, ng_ = 0;
+};
+
+struct StepRecord {
+  int step;
+  double time;
+  double diameter;
+  int iterations;
+  double residual;
+  double max_bending_moment;
+  double wall_seconds;
+  // generated stents only (else NaN): diameters of the outer crowns of the end rings and of
+  // the crowns of the middle ring(s), and the stent length along the device axis
+  double distal_diameter = std::numeric_limits<double>::quiet_NaN();
+  double central_diameter = std::numeric_limits<double>::quiet_NaN();
+  double length = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Writes summary.json; returns the text written.
+std::string write_summary(const std::string& path, const BeamModel& m,
+                          const std::vector<StepRecord>& steps, bool generated_stent,
+                          const std::string& status, double newton_seconds = 0.0,
+                          long newton_iterations = 0, double initial_length = 0.0);
+
+}  // namespace angio::beam

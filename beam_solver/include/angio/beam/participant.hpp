@@ -1,0 +1,52 @@
+// BeamParticipant implementation: drives a BeamModel for the standalone loop and the coupler.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "angio/beam/output.hpp"
+#include "angio/beam/scene.hpp"
+#include "angio/participant/beam_participant.hpp"
+
+namespace angio::beam {
+
+class BeamSolverParticipant : public participant::BeamParticipant {
+ public:
+  // run_dir empty → no output files.
+  BeamSolverParticipant(BeamScene scene, const std::string& run_dir);
+  ~BeamSolverParticipant() override;
+
+  participant::SamplePoints sample_points() const override;
+  void begin_step(int step, double time) override;
+  participant::SolveStats solve(const std::vector<participant::Vec3>& line_loads) override;
+  void end_step(bool accept) override;
+  void finish() override;
+
+  BeamModel& model() { return *scene_.model; }
+  const std::vector<StepRecord>& records() const { return records_; }
+  // Wall time of all Newton iterations / number of iterations (s), for benchmarks.
+  double seconds_per_iteration() const {
+    return iterations_total_ ? newton_seconds_ / iterations_total_ : 0.0;
+  }
+
+ private:
+  BeamScene scene_;
+  std::string run_dir_;
+  std::unique_ptr<BeamOutput> out_;
+  std::vector<StepRecord> records_;
+  int step_ = 0, accepted_ = 0;
+  double time_ = 0;
+  int step_iterations_ = 0;
+  double step_residual_ = 0;
+  std::chrono::steady_clock::time_point step_start_;
+  double newton_seconds_ = 0;
+  long iterations_total_ = 0;
+  bool finished_ = false;
+  bool last_written_ = true;
+  double initial_length_ = 0;
+  void stent_measures(StepRecord& r, bool reference) const;
+};
+
+}  // namespace angio::beam

@@ -1,0 +1,317 @@
+#include "angio/beam/element.hpp"
+
+#include <cmath>
+
+#include "angio/beam/dual.hpp"
+
+namespace angio::beam {
+
+namespace {
+
+template <class T>
+struct Q {
+  T w, x, y, z;
+};
+
+template <class T>
+Q<T> qmul(const Q<T>& a, const Q<T>& b) {
+  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+          a.w * b.x + b.w * a.x + (a.y * b.z - a.z * b.y),
+          a.w * b.y + b.w * a.y + (a.z * b.x - a.x * b.z),
+          a.w * b.z + b.w * a.z + (a.x * b.y - a.y * b.x)};
+}
+template <class T>
+Q<T> qconst(const Quat& q) {
+  return {T(q.w()), T(q.x()), T(q.y()), T(q.z())};
+}
+template <class T>
+Q<T> qconj(const Q<T>& a) {
+  return {a.w, -a.x, -a.y, -a.z};
+}
+template <class T>
+Q<T> qnormalize(const Q<T>& a) {
+  using std::sqrt;
+  T n = sqrt(a.w * a.w + a.x * a.x + a.y * a.y + a.z * a.z);
+  T in = T(1.0) / n;
+  return {a.w * in, a.x * in, a.y * in, a.z * in};
+}
+// First-order exponential map of a (value-zero) perturbation: exact for first and mixed
+// second derivatives, which is all the tangent needs.
+template <class T>
+Q<T> qsmall(const T* th) {
+  return {T(1.0), th[0] * 0.5, th[1] * 0.5, th[2] * 0.5};
+}
+// Rotates v by q^T (q unit): v' = Λᵀ v.
+template <class T>
+void rotate_transpose(const Q<T>& q, const T* v, T* out) {
+  // u = vector part of conj(q) = -q.v; v' = v + 2w (u×v) + 2 u×(u×v)
+  T ux = -q.x, uy = -q.y, uz = -q.z;
+  T cx = uy * v[2] - uz * v[1];
+  T cy = uz * v[0] - ux * v[2];
+  T cz = ux * v[1] - uy * v[0];
+  T ccx = uy * cz - uz * cy;
+  T ccy = uz * cx - ux * cz;
+  T ccz = ux * cy - uy * cx;
+  out[0] = v[0] + 2.0 * (q.w * cx) + 2.0 * ccx;
+  out[1] = v[1] + 2.0 * (q.w * cy) + 2.0 * ccy;
+  out[2] = v[2] + 2.0 * (q.w * cz) + 2.0 * ccz;
+}
+
+// Strain (Γ, Ω) without the reference subtraction, for perturbations p (12 variables, order
+// x1, θ1, x2, θ2) applied as x + p, Λ = (I + ½ p̂θ...) Λ; pe and pd are two sets combined as
+// exp(pe) exp(pd) Λ.
+template <class T>
+void strains_raw(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
+                 const Quat& R2, const T* pe, const T* pd, T* S, Q<T>* qr_out = nullptr) {
+  using std::sqrt;
+  using std::atan2;
+  Q<T> L1 = qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R1 * ref.O1));
+  Q<T> L2 = qmul(qmul(qsmall(pe + 9), qsmall(pd + 9)), qconst<T>(R2 * ref.O2));
+  L1 = qnormalize(L1);
+  L2 = qnormalize(L2);
+  Q<T> rel = qmul(qconj(L1), L2);
+  if (val(rel.w) < 0.0) rel = {-rel.w, -rel.x, -rel.y, -rel.z};
+  // φ = log(rel) = 2 atan2(|v|, w) v/|v|
+  T s = rel.x * rel.x + rel.y * rel.y + rel.z * rel.z;
+  T f;
+  const double sv = val(s), wv = val(rel.w);
+  if (sv < 1e-16 * wv * wv) {
+    T t2 = s / (rel.w * rel.w);
+    f = (1.0 - t2 / 3.0) / rel.w;
+  } else {
+    T nv = sqrt(s);
+    f = atan2(nv, rel.w) / nv;
+  }
+  const double iL = 1.0 / ref.L0;
+  S[3] = 2.0 * f * rel.x * iL;
+  S[4] = 2.0 * f * rel.y * iL;
+  S[5] = 2.0 * f * rel.z * iL;
+  // half rotation: sqrt(rel) = normalize(1 + rel)
+  Q<T> half = qnormalize(Q<T>{rel.w + 1.0, rel.x, rel.y, rel.z});
+  Q<T> qr = qmul(L1, half);
+  T d[3];
+  for (int i = 0; i < 3; ++i) d[i] = (T(x2(i)) + pe[6 + i] + pd[6 + i] - T(x1(i)) - pe[i] - pd[i]) * iL;
+  T g[3];
+  rotate_transpose(qr, d, g);
+  S[0] = g[0] - 1.0;
+  S[1] = g[1];
+  S[2] = g[2];
+  if (qr_out) *qr_out = qr;
+}
+
+Vec6 raw_strain_double(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
+                       const Quat& R2) {
+  double z[12] = {0};
+  double S[6];
+  strains_raw<double>(ref, x1, x2, R1, R2, z, z, S);
+  Vec6 out;
+  for (int i = 0; i < 6; ++i) out(i) = S[i];
+  return out;
+}
+
+// Rotation part only: perturbations of the two nodal rotations (6 variables each set).
+// Returns φ (relative rotation vector, Λ1 frame) and Q = Λ_rᵀ as a row-major 3×3.
+template <class T>
+void rotation_kernel(const ElementReference& ref, const Quat& R1, const Quat& R2, const T* pe,
+                     const T* pd, T* phi, T* Qm) {
+  using std::sqrt;
+  using std::atan2;
+  Q<T> L1 = qnormalize(qmul(qmul(qsmall(pe), qsmall(pd)), qconst<T>(R1 * ref.O1)));
+  Q<T> L2 = qnormalize(qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R2 * ref.O2)));
+  Q<T> rel = qmul(qconj(L1), L2);
+  if (val(rel.w) < 0.0) rel = {-rel.w, -rel.x, -rel.y, -rel.z};
+  T s = rel.x * rel.x + rel.y * rel.y + rel.z * rel.z;
+  T f;
+  const double sv = val(s), wv = val(rel.w);
+  if (sv < 1e-16 * wv * wv) {
+    T t2 = s / (rel.w * rel.w);
+    f = (1.0 - t2 / 3.0) / rel.w;
+  } else {
+    T nv = sqrt(s);
+    f = atan2(nv, rel.w) / nv;
+  }
+  phi[0] = 2.0 * f * rel.x;
+  phi[1] = 2.0 * f * rel.y;
+  phi[2] = 2.0 * f * rel.z;
+  Q<T> qr = qnormalize(qmul(L1, qnormalize(Q<T>{rel.w + 1.0, rel.x, rel.y, rel.z})));
+  // Λ_rᵀ = (w² − v·v) I + 2 v vᵀ − 2 w [v]×
+  const T a = qr.w * qr.w - (qr.x * qr.x + qr.y * qr.y + qr.z * qr.z);
+  const T v[3] = {qr.x, qr.y, qr.z};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Qm[3 * i + j] = 2.0 * (v[i] * v[j]);
+  for (int i = 0; i < 3; ++i) Qm[4 * i] = Qm[4 * i] + a;
+  const T wx = 2.0 * (qr.w * v[0]), wy = 2.0 * (qr.w * v[1]), wz = 2.0 * (qr.w * v[2]);
+  // −2w[v]×: [v]× = [[0,−z,y],[z,0,−x],[−y,x,0]]
+  Qm[1] = Qm[1] + wz;
+  Qm[2] = Qm[2] - wy;
+  Qm[3] = Qm[3] - wz;
+  Qm[5] = Qm[5] + wx;
+  Qm[6] = Qm[6] + wy;
+  Qm[7] = Qm[7] - wx;
+}
+
+}  // namespace
+
+Quat quat_exp(const Vec3& th) {
+  const double a = th.norm();
+  if (a < 1e-300) return Quat::Identity();
+  return Quat(Eigen::AngleAxisd(a, th / a));
+}
+
+Vec3 quat_log(const Quat& qin) {
+  Quat q = qin.normalized();
+  if (q.w() < 0) q.coeffs() *= -1.0;
+  const Vec3 v = q.vec();
+  const double nv = v.norm();
+  if (nv < 1e-12) return 2.0 * v / q.w();
+  return 2.0 * std::atan2(nv, q.w()) * v / nv;
+}
+
+Quat triad_from_tangent(const Vec3& t, const Vec3& up) {
+  Vec3 e1 = t.normalized();
+  Vec3 e2 = up - up.dot(e1) * e1;
+  if (e2.norm() < 1e-8 * up.norm() || up.norm() == 0) {
+    // pick any perpendicular
+    Vec3 a = std::abs(e1.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    e2 = a - a.dot(e1) * e1;
+  }
+  e2.normalize();
+  Vec3 e3 = e1.cross(e2);
+  Mat3 R;
+  R.col(0) = e1;
+  R.col(1) = e2;
+  R.col(2) = e3;
+  return Quat(R).normalized();
+}
+
+ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Quat& O1,
+                                        const Quat& O2) {
+  ElementReference ref;
+  ref.L0 = (X2 - X1).norm();
+  ref.O1 = O1.normalized();
+  ref.O2 = O2.normalized();
+  Vec6 s = raw_strain_double(ref, X1, X2, Quat::Identity(), Quat::Identity());
+  ref.Gamma0 = s.head<3>();
+  ref.Omega0 = s.tail<3>();
+  return ref;
+}
+
+Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
+                    const Quat& R2) {
+  Vec6 s = raw_strain_double(ref, x1, x2, R1, R2);
+  s.head<3>() -= ref.Gamma0;
+  s.tail<3>() -= ref.Omega0;
+  return s;
+}
+
+Quat element_midpoint_triad(const ElementReference& ref, const Quat& R1, const Quat& R2) {
+  double z[12] = {0};
+  double S[6];
+  Q<double> qr;
+  strains_raw<double>(ref, Vec3::Zero(), Vec3::UnitX(), R1, R2, z, z, S, &qr);
+  return Quat(qr.w, qr.x, qr.y, qr.z).normalized();
+}
+
+ElementResult evaluate_element(const Section& sec, const ElementReference& ref, const Vec3& x1,
+                               const Vec3& x2, const Quat& R1, const Quat& R2,
+                               const PlasticState& committed, bool with_tangent) {
+  // Strain S = (Γ, Ω) with Γ = Q (x2 − x1)/L − E1 − Γ0, Ω = φ/L − Ω0, where Q = Λ_rᵀ and φ
+  // depend only on the rotations. Nested duals over the 6 rotation variables give Q, φ, their
+  // first derivatives w.r.t. the variations (ε) and the increments (Δ), and the mixed second
+  // derivatives; the position dependence is linear and added by hand.
+  ElementResult out;
+  using D1 = Dual<double, 6>;
+  using D2 = Dual<D1, 6>;
+  static constexpr int rdof[6] = {3, 4, 5, 9, 10, 11};
+  const double iL = 1.0 / ref.L0;
+  const Vec3 d0 = x2 - x1;
+  Eigen::Matrix<double, 6, 12> B = Eigen::Matrix<double, 6, 12>::Zero();
+  std::array<Mat12, 6> H;
+  Vec6 strain;
+  if (with_tangent) {
+    D2 pe[6], pd[6];
+    for (int i = 0; i < 6; ++i) {
+      pe[i] = D2(0.0);
+      pe[i].d[i] = D1(1.0);
+      pd[i] = D2(0.0);
+      pd[i].v.d[i] = 1.0;
+    }
+    D2 phi[3], Q[9];
+    rotation_kernel<D2>(ref, R1, R2, pe, pd, phi, Q);
+    for (auto& h : H) h.setZero();
+    for (int k = 0; k < 3; ++k) {
+      // Γ_k
+      double g = 0;
+      for (int j = 0; j < 3; ++j) g += Q[3 * k + j].v.v * d0(j);
+      strain(k) = g * iL;
+      for (int j = 0; j < 3; ++j) {
+        B(k, j) = -Q[3 * k + j].v.v * iL;
+        B(k, 6 + j) = Q[3 * k + j].v.v * iL;
+      }
+      for (int a = 0; a < 6; ++a) {
+        double ba = 0;
+        for (int j = 0; j < 3; ++j) ba += Q[3 * k + j].d[a].v * d0(j);
+        B(k, rdof[a]) = ba * iL;
+        for (int b = 0; b < 6; ++b) {
+          double hab = 0;
+          for (int j = 0; j < 3; ++j) hab += Q[3 * k + j].d[a].d[b] * d0(j);
+          H[k](rdof[a], rdof[b]) = hab * iL;
+        }
+        for (int j = 0; j < 3; ++j) {
+          // ε_θa with Δ_x, and ε_x with Δ_θa
+          H[k](rdof[a], j) = -Q[3 * k + j].d[a].v * iL;
+          H[k](rdof[a], 6 + j) = Q[3 * k + j].d[a].v * iL;
+          H[k](j, rdof[a]) = -Q[3 * k + j].v.d[a] * iL;
+          H[k](6 + j, rdof[a]) = Q[3 * k + j].v.d[a] * iL;
+        }
+      }
+      // Ω_k
+      strain(3 + k) = phi[k].v.v * iL;
+      for (int a = 0; a < 6; ++a) {
+        B(3 + k, rdof[a]) = phi[k].d[a].v * iL;
+        for (int b = 0; b < 6; ++b) H[3 + k](rdof[a], rdof[b]) = phi[k].d[a].d[b] * iL;
+      }
+    }
+  } else {
+    D1 pe[6], pd[6];
+    for (int i = 0; i < 6; ++i) {
+      pe[i] = D1(0.0);
+      pe[i].d[i] = 1.0;
+      pd[i] = D1(0.0);
+    }
+    D1 phi[3], Q[9];
+    rotation_kernel<D1>(ref, R1, R2, pe, pd, phi, Q);
+    for (int k = 0; k < 3; ++k) {
+      double g = 0;
+      for (int j = 0; j < 3; ++j) g += Q[3 * k + j].v * d0(j);
+      strain(k) = g * iL;
+      for (int j = 0; j < 3; ++j) {
+        B(k, j) = -Q[3 * k + j].v * iL;
+        B(k, 6 + j) = Q[3 * k + j].v * iL;
+      }
+      for (int a = 0; a < 6; ++a) {
+        double ba = 0;
+        for (int j = 0; j < 3; ++j) ba += Q[3 * k + j].d[a] * d0(j);
+        B(k, rdof[a]) = ba * iL;
+      }
+      strain(3 + k) = phi[k].v * iL;
+      for (int a = 0; a < 6; ++a) B(3 + k, rdof[a]) = phi[k].d[a] * iL;
+    }
+  }
+  strain(0) -= 1.0;
+  strain.head<3>() -= ref.Gamma0;
+  strain.tail<3>() -= ref.Omega0;
+  out.strain = strain;
+  out.section = evaluate_section(sec, strain, committed);
+  const Vec6& sig = out.section.stress;
+  out.residual = ref.L0 * (B.transpose() * sig);
+  if (with_tangent) {
+    out.tangent = ref.L0 * (B.transpose() * out.section.tangent * B);
+    for (int k = 0; k < 6; ++k) out.tangent += (ref.L0 * sig(k)) * H[k];
+  } else {
+    out.tangent.setZero();
+  }
+  return out;
+}
+
+}  // namespace angio::beam

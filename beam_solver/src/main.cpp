@@ -1,0 +1,62 @@
+// beam_solver: the stent side of the angioplasty co-simulation (DESIGN §2).
+//   beam_solver --scene FILE --run-dir DIR                       beam-only scene (standalone loop)
+//   beam_solver --scene FILE --run-dir DIR --endpoint E --run-id ID   co-simulation (serves the
+//                                                                      beam role to the coupler)
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+
+#include "angio/beam/participant.hpp"
+#include "angio/beam/scene.hpp"
+#include "angio/common/cli.hpp"
+#include "angio/common/log.hpp"
+#include "angio/participant/standalone.hpp"
+#ifdef ANGIO_HAVE_ROLE_SERVER
+#include "angio/participant/role_server.hpp"
+#endif
+
+int main(int argc, char** argv) {
+  angio::cli::Parser cli("beam_solver",
+                         "Stent as geometrically exact Simo-Reissner beams with elasto-plastic "
+                         "bending.\nWithout --endpoint the scene is solved standalone (beam-only "
+                         "scene); with --endpoint the beam role is served to the coupler.");
+  cli.add_common();
+  try {
+    if (!cli.parse(argc, argv)) return 0;
+    angio::cli::setup_logging(cli, "beam");
+    if (!cli.has("scene") || cli.get("scene").empty())
+      throw angio::cli::UsageError("--scene FILE is required");
+  } catch (const angio::cli::UsageError& e) {
+    std::fprintf(stderr, "beam_solver: %s\n%s", e.what(), cli.usage().c_str());
+    return 2;
+  }
+  try {
+    angio::beam::BeamScene scene = angio::beam::load_beam_scene(cli.get("scene"));
+    const std::string run_dir = cli.get("run-dir");
+    std::filesystem::create_directories(run_dir);
+    const auto time = scene.time;
+    angio::beam::BeamSolverParticipant beam(std::move(scene), run_dir);
+    const auto endpoint = cli.maybe("endpoint");
+    if (endpoint && !endpoint->empty()) {
+      // ---- co-simulation: serve the beam role to the coupler ----
+#ifdef ANGIO_HAVE_ROLE_SERVER
+      angio::participant::ServeOptions o;
+      o.endpoint = *endpoint;
+      o.run_id = cli.get("run-id");
+      o.timeout = std::chrono::milliseconds(static_cast<long>(1000.0 * cli.number("timeout")));
+      o.software = "beam_solver 0.1";
+      return angio::participant::serve(beam, o);
+#else
+      LOG_ERROR("this beam_solver was built without the zenoh transport; --endpoint unsupported");
+      return 2;
+#endif
+    }
+    return angio::participant::run_standalone(beam, time);
+  } catch (const angio::scene::SceneError& e) {
+    LOG_ERROR(e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    LOG_ERROR("beam_solver: " << e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,524 @@
+#include "angio/beam/model.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace angio::beam {
+
+void gauss_legendre_01(int n, std::vector<double>& xi, std::vector<double>& w) {
+  static const std::vector<std::vector<double>> P = {
+      {0.0},
+      {-0.5773502691896257, 0.5773502691896257},
+      {-0.7745966692414834, 0.0, 0.7745966692414834},
+      {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526},
+      {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640},
+      {-0.9324695142031521, -0.6612093864662645, -0.2386191860831969, 0.2386191860831969,
+       0.6612093864662645, 0.9324695142031521}};
+  static const std::vector<std::vector<double>> W = {
+      {2.0},
+      {1.0, 1.0},
+      {0.5555555555555556, 0.8888888888888888, 0.5555555555555556},
+      {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538},
+      {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+       0.2369268850561891},
+      {0.1713244923791704, 0.3607615730481386, 0.4679139345726910, 0.4679139345726910,
+       0.3607615730481386, 0.1713244923791704}};
+  if (n < 1 || n > 6) throw std::invalid_argument("sample points per element must be 1..6");
+  xi.resize(n);
+  w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    xi[i] = 0.5 * (P[n - 1][i] + 1.0);
+    w[i] = 0.5 * W[n - 1][i];
+  }
+}
+
+Axis::Projection Axis::project(const Vec3& x) const {
+  Projection best;
+  double bestd = std::numeric_limits<double>::infinity();
+  double s0 = 0;
+  const int ns = static_cast<int>(points.size()) - 1;
+  for (int i = 0; i < ns; ++i) {
+    const Vec3 d = points[i + 1] - points[i];
+    const double len = d.norm();
+    if (len <= 0) continue;  // repeated point
+    double t = (x - points[i]).dot(d) / (len * len);
+    if (i > 0) t = std::max(t, 0.0);
+    if (i < ns - 1) t = std::min(t, 1.0);
+    const Vec3 foot = points[i] + t * d;
+    const double dist = (x - foot).norm();
+    if (dist < bestd - 1e-14) {
+      bestd = dist;
+      best.foot = foot;
+      best.tangent = d / len;
+      best.s = s0 + t * len;
+    }
+    s0 += len;
+  }
+  Vec3 rv = x - best.foot;
+  rv -= rv.dot(best.tangent) * best.tangent;
+  best.r = rv.norm();
+  best.radial = best.r > 0 ? Vec3(rv / best.r) : Vec3::Zero();
+  return best;
+}
+
+int BeamModel::add_node(const Vec3& X) {
+  X_.push_back(X);
+  basis_.push_back(Mat3::Identity());
+  fixed_.push_back({false, false, false, false, false, false});
+  return static_cast<int>(X_.size()) - 1;
+}
+
+int BeamModel::add_section(const Section& s) {
+  sections_.push_back(s);
+  return static_cast<int>(sections_.size()) - 1;
+}
+
+int BeamModel::add_element(int n1, int n2, int section, const Vec3& up) {
+  if (n1 < 0 || n2 < 0 || n1 >= num_nodes() || n2 >= num_nodes() || n1 == n2)
+    throw std::invalid_argument("element nodes out of range");
+  const Vec3 t = X_[n2] - X_[n1];
+  Vec3 u = up;
+  if (u.norm() == 0) {
+    // default: the global axis least aligned with the element
+    Vec3 a = t.cwiseAbs();
+    int k = 0;
+    a.minCoeff(&k);
+    u = Vec3::Unit(k);
+  }
+  const Quat O = triad_from_tangent(t, u);
+  return add_element(n1, n2, section, O, O);
+}
+
+int BeamModel::add_element(int n1, int n2, int section, const Quat& O1, const Quat& O2) {
+  if (n1 < 0 || n2 < 0 || n1 >= num_nodes() || n2 >= num_nodes() || n1 == n2)
+    throw std::invalid_argument("element nodes out of range");
+  if (section < 0 || section >= static_cast<int>(sections_.size()))
+    throw std::invalid_argument("element section out of range");
+  if ((X_[n2] - X_[n1]).norm() <= 0) throw std::invalid_argument("element of zero length");
+  elem_nodes_.push_back({n1, n2});
+  elem_section_.push_back(section);
+  eref_.push_back(make_element_reference(X_[n1], X_[n2], O1, O2));
+  return static_cast<int>(elem_nodes_.size()) - 1;
+}
+
+void BeamModel::fix(int node, const std::array<bool, 6>& f) {
+  for (int i = 0; i < 6; ++i) fixed_.at(node)[i] = fixed_.at(node)[i] || f[i];
+}
+void BeamModel::set_basis(int node, const Mat3& B) { basis_.at(node) = B; }
+
+namespace {
+Mat3 cylindrical_basis(const Axis& axis, const Vec3& X) {
+  const auto p = axis.project(X);
+  Mat3 B;
+  if (p.r > 0) {
+    B.col(0) = p.radial;
+  } else {
+    B.col(0) = triad_from_tangent(p.tangent, Vec3::UnitX()).toRotationMatrix().col(1);
+  }
+  B.col(1) = p.tangent.cross(B.col(0));
+  B.col(2) = p.tangent;
+  return B;
+}
+}  // namespace
+
+// Local translation basis of such nodes: (radial, circumferential, axial).
+void BeamModel::fix_radial_only(int node) {
+  if (axis.project(X_.at(node)).r <= 0) throw std::invalid_argument("radial fixation of a node on the axis");
+  basis_[node] = cylindrical_basis(axis, X_[node]);
+  fixed_[node][1] = fixed_[node][2] = true;
+}
+
+void BeamModel::fix_axial(int node) {
+  basis_[node] = cylindrical_basis(axis, X_.at(node));
+  fixed_[node][2] = true;
+}
+
+void BeamModel::fix_circumferential(int node) {
+  if (axis.project(X_.at(node)).r <= 0)
+    throw std::invalid_argument("circumferential fixation of a node on the axis");
+  basis_[node] = cylindrical_basis(axis, X_[node]);
+  fixed_[node][1] = true;
+}
+
+void BeamModel::finalize() {
+  const int n = num_nodes();
+  free_.assign(n, {-1, -1, -1, -1, -1, -1});
+  nfree_ = 0;
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < 6; ++k)
+      if (!fixed_[i][k]) free_[i][k] = nfree_++;
+  for (const auto& pr : prescribed_rotations)
+    if (!(fixed_.at(pr.node)[3] && fixed_[pr.node][4] && fixed_[pr.node][5]))
+      throw std::invalid_argument("prescribed rotation needs all rotations of the node fixed");
+  for (const auto& pd : prescribed_displacements)
+    if (!fixed_.at(pd.node).at(pd.comp))
+      throw std::invalid_argument("prescribed displacement on a free DOF");
+  x_ = xc_ = X_;
+  R_.assign(n, Quat::Identity());
+  Rc_ = R_;
+  mp_committed_.assign(num_elements(), PlasticState{});
+  mp_trial_ = mp_committed_;
+  mnorm_.assign(num_elements(), 0.0);
+  stress_.assign(num_elements(), Vec6::Zero());
+  gauss_legendre_01(sample_points_per_element, gauss_xi_, gauss_w_);
+  q_ext_.assign(num_sample_points(), Vec3::Zero());
+  ref_radial_.assign(num_sample_points(), Vec3::Zero());
+  for (int g = 0; g < num_sample_points(); ++g) {
+    const int e = g / sample_points_per_element, k = g % sample_points_per_element;
+    const auto [a, b] = elem_nodes_[e];
+    ref_radial_[g] = axis.project((1.0 - gauss_xi_[k]) * X_[a] + gauss_xi_[k] * X_[b]).radial;
+  }
+  identity_basis_.assign(n, 1);
+  for (int i = 0; i < n; ++i) identity_basis_[i] = basis_[i].isIdentity(0.0) ? 1 : 0;
+  pattern_ = SpMat();
+  elem_pos_.clear();
+  lin_.reset();
+}
+
+Vec6 BeamModel::strain(int e) const {
+  const auto [a, b] = elem_nodes_[e];
+  return element_strain(eref_[e], x_[a], x_[b], R_[a], R_[b]);
+}
+
+Vec3 BeamModel::sample_position(int g) const {
+  const int e = g / sample_points_per_element, k = g % sample_points_per_element;
+  const auto [a, b] = elem_nodes_[e];
+  return (1.0 - gauss_xi_[k]) * x_[a] + gauss_xi_[k] * x_[b];
+}
+double BeamModel::sample_weight(int g) const {
+  const int e = g / sample_points_per_element, k = g % sample_points_per_element;
+  return gauss_w_[k] * eref_[e].L0;
+}
+double BeamModel::sample_radius(int g) const {
+  return element_section(g / sample_points_per_element).contact_radius;
+}
+void BeamModel::set_sample_line_loads(const std::vector<Vec3>& q) {
+  if (static_cast<int>(q.size()) != num_sample_points())
+    throw std::invalid_argument("expected " + std::to_string(num_sample_points()) +
+                                " sample line loads, got " + std::to_string(q.size()));
+  q_ext_ = q;
+}
+std::vector<Vec3> BeamModel::sample_load_nodal_forces() const {
+  std::vector<Vec3> f(num_nodes(), Vec3::Zero());
+  for (int g = 0; g < num_sample_points(); ++g) {
+    const int e = g / sample_points_per_element, k = g % sample_points_per_element;
+    const auto [a, b] = elem_nodes_[e];
+    const double w = sample_weight(g);
+    f[a] += (1.0 - gauss_xi_[k]) * w * q_ext_[g];
+    f[b] += gauss_xi_[k] * w * q_ext_[g];
+  }
+  return f;
+}
+
+double BeamModel::diameter() const {
+  double s = 0;
+  for (const auto& x : x_) s += axis.project(x).r;
+  return 2.0 * s / std::max(1, num_nodes());
+}
+
+void BeamModel::set_time(double t) {
+  time_ = t;
+  for (const auto& pd : prescribed_displacements) {
+    const Vec3 b = basis_[pd.node].col(pd.comp);
+    const double target = pd.value * pd.curve(t);
+    const double cur = b.dot(x_[pd.node] - X_[pd.node]);
+    x_[pd.node] += (target - cur) * b;
+  }
+  for (const auto& pr : prescribed_rotations) R_[pr.node] = quat_exp(pr.value * pr.curve(t));
+}
+
+void BeamModel::set_state(const std::vector<Vec3>& x, const std::vector<Quat>& R) {
+  x_ = x;
+  R_ = R;
+}
+
+Mat12 BeamModel::element_transform(int e) const {
+  Mat12 T = Mat12::Identity();
+  T.block<3, 3>(0, 0) = basis_[elem_nodes_[e][0]];
+  T.block<3, 3>(6, 6) = basis_[elem_nodes_[e][1]];
+  return T;
+}
+
+void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
+  if (nfree_ < 0) throw std::logic_error("BeamModel::finalize() not called");
+  const int ne = num_elements();
+  Eigen::VectorXd rg = Eigen::VectorXd::Zero(6 * num_nodes());
+  std::vector<Eigen::Triplet<double>> trip;
+  if (K && elem_pos_.empty()) trip.reserve(static_cast<size_t>(ne) * 144);
+  // distributed loads at this time
+  std::vector<Vec3> eq(ne, Vec3::Zero());
+  std::vector<double> ep(ne, 0.0), epd(ne, 0.0);  // follower and dead radial loads
+  for (const auto& l : line_loads) {
+    const Vec3 q = l.q * l.curve(time_);
+    if (l.elements.empty())
+      for (auto& v : eq) v += q;
+    else
+      for (int e : l.elements) eq.at(e) += q;
+  }
+  for (const auto& l : radial_loads) {
+    const double p = l.p * l.curve(time_);
+    auto& tgt = l.follower ? ep : epd;
+    if (l.elements.empty())
+      for (auto& v : tgt) v += p;
+    else
+      for (int e : l.elements) tgt.at(e) += p;
+  }
+  const int ng = sample_points_per_element;
+  std::vector<int> elem_idx(static_cast<size_t>(ne) * 12);
+  for (int e = 0; e < ne; ++e)
+    for (int k = 0; k < 6; ++k) {
+      elem_idx[12 * e + k] = free_[elem_nodes_[e][0]][k];
+      elem_idx[12 * e + 6 + k] = free_[elem_nodes_[e][1]][k];
+    }
+  const bool first_pattern = K && elem_pos_.empty();
+  double* vals = nullptr;
+  if (K && !first_pattern) {
+    *K = pattern_;
+    vals = K->valuePtr();
+    std::fill(vals, vals + K->nonZeros(), 0.0);
+  }
+  auto scatter = [&](int e, const int* idx, const Mat12& Km) {
+    if (first_pattern) {
+      for (int i = 0; i < 12; ++i) {
+        if (idx[i] < 0) continue;
+        for (int j = 0; j < 12; ++j)
+          if (idx[j] >= 0) trip.emplace_back(idx[i], idx[j], Km(i, j));
+      }
+    } else {
+      const int* pos = &elem_pos_[144 * static_cast<size_t>(e)];
+      for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j)
+          if (pos[12 * i + j] >= 0) vals[pos[12 * i + j]] += Km(i, j);
+    }
+  };
+  // Element kernels are independent: evaluate them in parallel (OpenMP, when available), then
+  // add loads and scatter serially.
+  std::vector<ElementResult> evs(ne);
+#ifdef _OPENMP
+#pragma omp parallel for schedule(static) if (ne >= 64)
+#endif
+  for (int e = 0; e < ne; ++e) {
+    const auto [a, b] = elem_nodes_[e];
+    evs[e] = evaluate_element(sections_[elem_section_[e]], eref_[e], x_[a], x_[b], R_[a], R_[b],
+                              mp_committed_[e], K != nullptr);
+  }
+  for (int e = 0; e < ne; ++e) {
+    const auto [a, b] = elem_nodes_[e];
+    ElementResult& ev = evs[e];
+    mp_trial_[e] = ev.section.state;
+    mnorm_[e] = ev.section.bending_moment_norm;
+    stress_[e] = ev.section.stress;
+    Vec12& re = ev.residual;
+    Mat12& Ke = ev.tangent;
+    for (int k = 0; k < ng; ++k) {
+      const int g = e * ng + k;
+      const double N2 = gauss_xi_[k], N1 = 1.0 - N2;
+      const double w = gauss_w_[k] * eref_[e].L0;
+      Vec3 q = q_ext_[g] + eq[e] + epd[e] * ref_radial_[g];
+      if (ep[e] != 0.0) {
+        const Vec3 xg = N1 * x_[a] + N2 * x_[b];
+        const auto pr = axis.project(xg);
+        q += ep[e] * pr.radial;
+        if (K && pr.r > 0) {
+          const Mat3 P = Mat3::Identity() - pr.tangent * pr.tangent.transpose();
+          const Mat3 dq = ep[e] / pr.r * (P - pr.radial * pr.radial.transpose());
+          Ke.block<3, 3>(0, 0) -= N1 * N1 * w * dq;
+          Ke.block<3, 3>(0, 6) -= N1 * N2 * w * dq;
+          Ke.block<3, 3>(6, 0) -= N2 * N1 * w * dq;
+          Ke.block<3, 3>(6, 6) -= N2 * N2 * w * dq;
+        }
+      }
+      re.segment<3>(0) -= N1 * w * q;
+      re.segment<3>(6) -= N2 * w * q;
+    }
+    rg.segment<6>(6 * a) += re.segment<6>(0);
+    rg.segment<6>(6 * b) += re.segment<6>(6);
+    if (K) {
+      const int* idx = &elem_idx[12 * e];
+      if (identity_basis_[a] && identity_basis_[b]) {
+        scatter(e, idx, Ke);
+      } else {
+        const Mat12 T = element_transform(e);
+        const Mat12 Kl = T.transpose() * Ke * T;
+        scatter(e, idx, Kl);
+      }
+    }
+  }
+  if (K && first_pattern) {
+    pattern_.resize(nfree_, nfree_);
+    pattern_.setFromTriplets(trip.begin(), trip.end());
+    pattern_.makeCompressed();
+    // positions of every element entry in the compressed pattern, for the next assemblies
+    elem_pos_.assign(static_cast<size_t>(ne) * 144, -1);
+    const int* outer = pattern_.outerIndexPtr();
+    const int* inner = pattern_.innerIndexPtr();
+    for (int e = 0; e < ne; ++e) {
+      const int* idx = &elem_idx[12 * e];
+      for (int i = 0; i < 12; ++i) {
+        if (idx[i] < 0) continue;
+        for (int j = 0; j < 12; ++j) {
+          if (idx[j] < 0) continue;
+          // column idx[j], row idx[i]
+          const int* lo = inner + outer[idx[j]];
+          const int* hi = inner + outer[idx[j] + 1];
+          const int* it = std::lower_bound(lo, hi, idx[i]);
+          elem_pos_[144 * e + 12 * i + j] = static_cast<int>(it - inner);
+        }
+      }
+    }
+  }
+  for (const auto& l : nodal_loads) {
+    const double c = l.curve(time_);
+    rg.segment<3>(6 * l.node) -= c * l.force;
+    rg.segment<3>(6 * l.node + 3) -= c * l.moment;
+  }
+  r.setZero(nfree_);
+  for (int n = 0; n < num_nodes(); ++n) {
+    const Vec3 rt = basis_[n].transpose() * rg.segment<3>(6 * n);
+    for (int k = 0; k < 3; ++k) {
+      if (free_[n][k] >= 0) r(free_[n][k]) = rt(k);
+      if (free_[n][3 + k] >= 0) r(free_[n][3 + k]) = rg(6 * n + 3 + k);
+    }
+  }
+  if (K && first_pattern) {
+    K->resize(nfree_, nfree_);
+    K->setFromTriplets(trip.begin(), trip.end());
+    K->makeCompressed();
+  }
+}
+
+Eigen::VectorXd BeamModel::global_residual() {
+  // temporarily treat all DOFs as free in the global basis
+  auto free_save = free_;
+  auto basis_save = basis_;
+  int nfree_save = nfree_;
+  nfree_ = 0;
+  for (int n = 0; n < num_nodes(); ++n) {
+    basis_[n] = Mat3::Identity();
+    for (int k = 0; k < 6; ++k) free_[n][k] = nfree_++;
+  }
+  Eigen::VectorXd r;
+  assemble(nullptr, r);
+  free_ = free_save;
+  basis_ = basis_save;
+  nfree_ = nfree_save;
+  return r;
+}
+
+void BeamModel::apply_increment(const Eigen::VectorXd& d, double alpha) {
+  for (int n = 0; n < num_nodes(); ++n) {
+    Vec3 dx = Vec3::Zero(), dth = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      if (free_[n][k] >= 0) dx += d(free_[n][k]) * basis_[n].col(k);
+      if (free_[n][3 + k] >= 0) dth(k) = d(free_[n][3 + k]);
+    }
+    x_[n] += alpha * dx;
+    if (dth.squaredNorm() > 0) R_[n] = (quat_exp(alpha * dth) * R_[n]).normalized();
+  }
+}
+
+void BeamModel::commit() {
+  xc_ = x_;
+  Rc_ = R_;
+  mp_committed_ = mp_trial_;
+}
+
+void BeamModel::restore() {
+  x_ = xc_;
+  R_ = Rc_;
+  mp_trial_ = mp_committed_;
+}
+
+namespace {
+std::string history_text(const std::vector<double>& h) {
+  std::ostringstream os;
+  os.precision(3);
+  os << std::scientific;
+  for (size_t i = 0; i < h.size(); ++i) os << (i ? ", " : "") << h[i];
+  return os.str();
+}
+}  // namespace
+
+NewtonStats BeamModel::solve() {
+  const auto t0 = std::chrono::steady_clock::now();
+  NewtonStats st;
+  if (!lin_) lin_ = make_linear_solver(newton.linear_solver);
+  SpMat K;
+  Eigen::VectorXd r;
+  assemble(&K, r);
+  double rn = r.norm();
+  const double r0 = rn;
+  st.residual_history.push_back(rn);
+  auto finish = [&](bool ok, const std::string& msg) {
+    st.converged = ok;
+    st.residual = rn;
+    st.message = msg;
+    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return st;
+  };
+  if (!std::isfinite(rn)) return finish(false, "residual is NaN/Inf at the start of the solve");
+  const double rtol = std::max(newton.residual_tol, newton.residual_rel_tol * r0);
+  if (rn <= newton.residual_tol) return finish(true, "");
+  double dn = std::numeric_limits<double>::infinity();
+  for (int it = 1; it <= newton.max_iterations; ++it) {
+    Eigen::VectorXd d;
+    try {
+      d = lin_->solve(K, -r);
+    } catch (const std::exception& e) {
+      return finish(false, std::string("linear solve failed in iteration ") + std::to_string(it) +
+                               ": " + e.what() + "; residual history: " +
+                               history_text(st.residual_history));
+    }
+    if (!d.allFinite())
+      return finish(false, "Newton increment is NaN/Inf in iteration " + std::to_string(it));
+    const auto xs = x_;
+    const auto Rs = R_;
+    double alpha = 1.0;
+    Eigen::VectorXd rnew;
+    SpMat Knew;
+    for (int ls = 0;; ++ls) {
+      apply_increment(d, alpha);
+      assemble(&Knew, rnew);
+      const double rnn = rnew.norm();
+      // Energy-norm line search (Crisfield): accept if the residual norm or the work of the
+      // residual along the increment |d·r(α)| decreases; beams mix stiff axial and soft bending
+      // modes, so the plain residual norm is a poor merit function early in the iteration.
+      const bool ok = std::isfinite(rnn) &&
+                      (!newton.line_search || rnn <= rn || std::abs(d.dot(rnew)) <= std::abs(d.dot(r)));
+      if (ok || ls >= newton.max_line_search) {
+        if (!std::isfinite(rnn)) {
+          rn = rnn;
+          st.iterations = it;
+          return finish(false, "residual became NaN/Inf in iteration " + std::to_string(it));
+        }
+        break;
+      }
+      x_ = xs;
+      R_ = Rs;
+      alpha *= 0.5;
+    }
+    K = std::move(Knew);
+    r = std::move(rnew);
+    rn = r.norm();
+    dn = alpha * d.norm();
+    st.iterations = it;
+    st.residual_history.push_back(rn);
+    st.increment_history.push_back(dn);
+    if (rn > 1e8 * std::max(r0, newton.residual_tol))
+      return finish(false, "Newton diverged in iteration " + std::to_string(it) +
+                               " (residual grew by more than 1e8); residual history: " +
+                               history_text(st.residual_history));
+    if (rn <= rtol && dn <= newton.increment_tol) return finish(true, "");
+    // round-off floor: increment negligible and residual within 100× the tolerance
+    if (dn <= 1e-3 * newton.increment_tol && rn <= 100.0 * rtol) return finish(true, "");
+  }
+  return finish(false, "Newton did not converge in " + std::to_string(newton.max_iterations) +
+                           " iterations; residual history: " + history_text(st.residual_history) +
+                           "; last increment " + std::to_string(dn));
+}
+
+}  // namespace angio::beam

@@ -1,0 +1,276 @@
+#include "angio/beam/output.hpp"
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace angio::beam {
+
+namespace {
+
+void write_dataset(hid_t loc, const std::string& name, const std::vector<double>& data,
+                   hsize_t rows, hsize_t cols) {
+  hsize_t dims[2] = {rows, cols};
+  const int rank = cols == 1 ? 1 : 2;
+  hid_t space = H5Screate_simple(rank, dims, nullptr);
+  hid_t ds = H5Dcreate2(loc, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (ds < 0) throw std::runtime_error("HDF5: cannot create dataset " + name);
+  if (rows > 0) H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
+  H5Dclose(ds);
+  H5Sclose(space);
+}
+
+void write_int_dataset(hid_t loc, const std::string& name, const std::vector<int>& data,
+                       hsize_t rows, hsize_t cols) {
+  hsize_t dims[2] = {rows, cols};
+  hid_t space = H5Screate_simple(2, dims, nullptr);
+  hid_t ds = H5Dcreate2(loc, name.c_str(), H5T_NATIVE_INT, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (ds < 0) throw std::runtime_error("HDF5: cannot create dataset " + name);
+  H5Dwrite(ds, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
+  H5Dclose(ds);
+  H5Sclose(space);
+}
+
+std::vector<double> flat(const std::vector<Vec3>& v) {
+  std::vector<double> out;
+  out.reserve(3 * v.size());
+  for (const auto& x : v) out.insert(out.end(), {x.x(), x.y(), x.z()});
+  return out;
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream os;
+  os << std::setprecision(10) << v;
+  return os.str();
+}
+
+}  // namespace
+
+BeamOutput::BeamOutput(const std::string& dir) : dir_(dir) {
+  std::filesystem::create_directories(dir_);
+  const std::string path = dir_ + "/beam.h5";
+  file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (file_ < 0) throw std::runtime_error("cannot create " + path);
+}
+
+BeamOutput::~BeamOutput() { close(); }
+
+void BeamOutput::close() {
+  if (file_ >= 0) {
+    H5Fclose(static_cast<hid_t>(file_));
+    file_ = -1;
+  }
+}
+
+void BeamOutput::write_step(const BeamModel& m, int step, double time) {
+  if (file_ < 0) return;
+  const hid_t f = static_cast<hid_t>(file_);
+  nn_ = m.num_nodes();
+  ne_ = m.num_elements();
+  ng_ = m.num_sample_points();
+  if (steps_.empty()) {
+    hid_t g = H5Gcreate2(f, "/mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    std::vector<int> conn;
+    for (int e = 0; e < ne_; ++e) {
+      conn.push_back(m.element_nodes(e)[0]);
+      conn.push_back(m.element_nodes(e)[1]);
+    }
+    write_int_dataset(g, "connectivity", conn, ne_, 2);
+    std::vector<Vec3> X(nn_);
+    for (int n = 0; n < nn_; ++n) X[n] = m.reference_position(n);
+    write_dataset(g, "reference_positions", flat(X), nn_, 3);
+    H5Gclose(g);
+  }
+  char name[64];
+  std::snprintf(name, sizeof name, "/step_%06d", static_cast<int>(steps_.size()));
+  hid_t g = H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) throw std::runtime_error(std::string("HDF5: cannot create group ") + name);
+  {
+    hsize_t one = 1;
+    hid_t sp = H5Screate_simple(1, &one, nullptr);
+    hid_t a = H5Acreate2(g, "time", H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a, H5T_NATIVE_DOUBLE, &time);
+    H5Aclose(a);
+    hid_t b = H5Acreate2(g, "step", H5T_NATIVE_INT, sp, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(b, H5T_NATIVE_INT, &step);
+    H5Aclose(b);
+    H5Sclose(sp);
+  }
+  std::vector<Vec3> x(nn_), u(nn_), rv(nn_);
+  std::vector<double> quat;
+  for (int n = 0; n < nn_; ++n) {
+    x[n] = m.position(n);
+    u[n] = x[n] - m.reference_position(n);
+    rv[n] = quat_log(m.rotation(n));
+    const Quat& q = m.rotation(n);
+    quat.insert(quat.end(), {q.w(), q.x(), q.y(), q.z()});
+  }
+  write_dataset(g, "positions", flat(x), nn_, 3);
+  write_dataset(g, "displacement", flat(u), nn_, 3);
+  write_dataset(g, "rotation_vector", flat(rv), nn_, 3);
+  write_dataset(g, "rotation_quaternion_wxyz", quat, nn_, 4);
+  write_dataset(g, "contact_force", flat(m.sample_load_nodal_forces()), nn_, 3);
+  std::vector<double> mb(ne_), kp(ne_), nx(ne_), mt(ne_);
+  for (int e = 0; e < ne_; ++e) {
+    mb[e] = m.bending_moment_norm(e);
+    kp[e] = m.committed_state(e).kappa_bar;
+    const Vec6 s = m.stress_resultants(e);
+    nx[e] = s(0);
+    mt[e] = s(3);
+  }
+  write_dataset(g, "bending_moment_norm", mb, ne_, 1);
+  write_dataset(g, "accumulated_plastic_curvature", kp, ne_, 1);
+  write_dataset(g, "axial_force", nx, ne_, 1);
+  write_dataset(g, "torsion_moment", mt, ne_, 1);
+  std::vector<Vec3> sx(ng_);
+  for (int i = 0; i < ng_; ++i) sx[i] = m.sample_position(i);
+  write_dataset(g, "sample_positions", flat(sx), ng_, 3);
+  write_dataset(g, "contact_line_loads", flat(m.sample_line_loads()), ng_, 3);
+  H5Gclose(g);
+  H5Fflush(f, H5F_SCOPE_GLOBAL);
+  steps_.push_back({step, time, std::string(name).substr(1)});
+  write_xdmf();
+}
+
+void BeamOutput::write_xdmf() const {
+  std::ostringstream os;
+  os << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n";
+  auto item = [&](const std::string& path, int rows, int cols, const char* type = "Float") {
+    std::ostringstream s;
+    s << "<DataItem Dimensions=\"" << rows;
+    if (cols > 1) s << " " << cols;
+    s << "\" NumberType=\"" << type << "\" Precision=\"" << (type[0] == 'I' ? 4 : 8)
+      << "\" Format=\"HDF\">beam.h5:" << path << "</DataItem>";
+    return s.str();
+  };
+  os << "<Grid Name=\"stent\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const auto& s : steps_) {
+    const std::string G = "/" + s.group + "/";
+    os << "<Grid Name=\"stent_" << s.step << "\" GridType=\"Uniform\">\n<Time Value=\"" << num(s.time)
+       << "\"/>\n<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << ne_
+       << "\">" << item("/mesh/connectivity", ne_, 2, "Int") << "</Topology>\n"
+       << "<Geometry GeometryType=\"XYZ\">" << item(G + "positions", nn_, 3) << "</Geometry>\n";
+    for (const char* a : {"displacement", "rotation_vector", "contact_force"})
+      os << "<Attribute Name=\"" << a << "\" AttributeType=\"Vector\" Center=\"Node\">"
+         << item(G + a, nn_, 3) << "</Attribute>\n";
+    for (const char* a : {"bending_moment_norm", "accumulated_plastic_curvature", "axial_force", "torsion_moment"})
+      os << "<Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Cell\">"
+         << item(G + a, ne_, 1) << "</Attribute>\n";
+    os << "</Grid>\n";
+  }
+  os << "</Grid>\n";
+  os << "<Grid Name=\"contact_samples\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const auto& s : steps_) {
+    const std::string G = "/" + s.group + "/";
+    os << "<Grid Name=\"samples_" << s.step << "\" GridType=\"Uniform\">\n<Time Value=\"" << num(s.time)
+       << "\"/>\n<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << ng_ << "\"/>\n"
+       << "<Geometry GeometryType=\"XYZ\">" << item(G + "sample_positions", ng_, 3) << "</Geometry>\n"
+       << "<Attribute Name=\"contact_line_load\" AttributeType=\"Vector\" Center=\"Node\">"
+       << item(G + "contact_line_loads", ng_, 3) << "</Attribute>\n</Grid>\n";
+  }
+  os << "</Grid>\n</Domain>\n</Xdmf>\n";
+  const std::string tmp = dir_ + "/beam.xdmf.tmp";
+  {
+    std::ofstream f(tmp);
+    f << os.str();
+  }
+  std::filesystem::rename(tmp, dir_ + "/beam.xdmf");
+}
+
+std::string write_summary(const std::string& path, const BeamModel& m,
+                          const std::vector<StepRecord>& steps, bool generated_stent,
+                          const std::string& status, double newton_seconds,
+                          long newton_iterations, double initial_length) {
+  std::ostringstream os;
+  os << "{\n  \"status\": \"" << status << "\",\n";
+  os << "  \"units\": {\"length\": \"mm\", \"force\": \"N\", \"moment\": \"N mm\", \"time\": \"s\"},\n";
+  os << "  \"num_nodes\": " << m.num_nodes() << ",\n  \"num_elements\": " << m.num_elements() << ",\n";
+  os << "  \"generated_stent\": " << (generated_stent ? "true" : "false") << ",\n";
+  double D0 = 0;
+  {
+    // initial (crimped) diameter from the reference positions
+    double s = 0;
+    for (int n = 0; n < m.num_nodes(); ++n) s += m.axis.project(m.reference_position(n)).r;
+    D0 = 2 * s / std::max(1, m.num_nodes());
+  }
+  double Dmax = D0, tmax = 0;
+  for (const auto& s : steps)
+    if (s.diameter > Dmax) {
+      Dmax = s.diameter;
+      tmax = s.time;
+    }
+  const double Dfinal = steps.empty() ? D0 : steps.back().diameter;
+  os << "  \"diameter\": {\"initial\": " << num(D0) << ", \"max\": " << num(Dmax)
+     << ", \"time_of_max\": " << num(tmax) << ", \"final\": " << num(Dfinal)
+     << ", \"recoil\": " << num(Dmax - Dfinal) << ", \"recoil_percent\": "
+     << num(Dmax > 0 ? 100.0 * (Dmax - Dfinal) / Dmax : 0.0)
+     << ", \"definition\": \"2 x mean radial distance of all nodes from the device axis\"},\n";
+  if (generated_stent && !steps.empty()) {
+    // dogboning = (D_distal − D_central)/D_distal; foreshortening = (L0 − L)/L0
+    double dbmax = -1e300, tdb = 0;
+    for (const auto& s : steps) {
+      const double db = (s.distal_diameter - s.central_diameter) / s.distal_diameter;
+      if (db > dbmax) {
+        dbmax = db;
+        tdb = s.time;
+      }
+    }
+    const auto& pk = *std::max_element(steps.begin(), steps.end(), [](const auto& a, const auto& b) {
+      return a.diameter < b.diameter;
+    });
+    const auto& fin = steps.back();
+    os << "  \"stent\": {\"length_initial\": " << num(initial_length) << ", \"length_at_max_diameter\": "
+       << num(pk.length) << ", \"length_final\": " << num(fin.length)
+       << ", \"foreshortening_at_max_diameter_percent\": " << num(100.0 * (initial_length - pk.length) / initial_length)
+       << ", \"foreshortening_final_percent\": " << num(100.0 * (initial_length - fin.length) / initial_length)
+       << ", \"distal_diameter_at_max\": " << num(pk.distal_diameter)
+       << ", \"central_diameter_at_max\": " << num(pk.central_diameter)
+       << ", \"dogboning_at_max_diameter_percent\": "
+       << num(100.0 * (pk.distal_diameter - pk.central_diameter) / pk.distal_diameter)
+       << ", \"dogboning_max_percent\": " << num(100.0 * dbmax) << ", \"time_of_dogboning_max\": " << num(tdb)
+       << ", \"definitions\": \"D_distal: outer crowns of the end rings, D_central: crowns of the middle ring(s); "
+          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = axial extent of the nodes\"},\n";
+  }
+  int total_it = 0;
+  double total_wall = 0;
+  for (const auto& s : steps) {
+    total_it += s.iterations;
+    total_wall += s.wall_seconds;
+  }
+  os << "  \"newton_iterations_total\": " << total_it << ",\n  \"wall_seconds_total\": " << num(total_wall)
+     << ",\n  \"newton_seconds_total\": " << num(newton_seconds) << ",\n  \"seconds_per_newton_iteration\": "
+     << num(newton_iterations > 0 ? newton_seconds / newton_iterations : 0.0) << ",\n";
+  os << "  \"steps\": [\n";
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const auto& s = steps[i];
+    os << "    {\"step\": " << s.step << ", \"time\": " << num(s.time) << ", \"diameter\": " << num(s.diameter)
+       << ", \"iterations\": " << s.iterations << ", \"residual\": " << num(s.residual)
+       << ", \"max_bending_moment\": " << num(s.max_bending_moment);
+    if (generated_stent)
+      os << ", \"distal_diameter\": " << num(s.distal_diameter) << ", \"central_diameter\": " << num(s.central_diameter)
+         << ", \"length\": " << num(s.length);
+    os
+       << ", \"wall_seconds\": " << num(s.wall_seconds) << "}" << (i + 1 < steps.size() ? "," : "") << "\n";
+  }
+  os << "  ],\n  \"final_positions\": [\n";
+  for (int n = 0; n < m.num_nodes(); ++n) {
+    const Vec3& x = m.position(n);
+    os << "    [" << num(x.x()) << ", " << num(x.y()) << ", " << num(x.z()) << "]"
+       << (n + 1 < m.num_nodes() ? "," : "") << "\n";
+  }
+  os << "  ]\n}\n";
+  std::ofstream f(path);
+  if (!f) throw std::runtime_error("cannot write " + path);
+  f << os.str();
+  return os.str();
+}
+
+}  // namespace angio::beam

@@ -1,0 +1,167 @@
+#include "angio/beam/participant.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "angio/common/log.hpp"
+
+namespace angio::beam {
+
+BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string& run_dir)
+    : scene_(std::move(scene)), run_dir_(run_dir) {
+  if (!run_dir_.empty()) {
+    out_ = std::make_unique<BeamOutput>(run_dir_ + "/beam");
+    out_->write_step(*scene_.model, 0, scene_.time.start);  // reference state
+  }
+  const BeamModel& m = *scene_.model;
+  if (scene_.stent) {
+    StepRecord r0{};
+    stent_measures(r0, true);
+    initial_length_ = r0.length;
+  }
+  LOG_INFO("beam model: " << m.num_nodes() << " nodes, " << m.num_elements() << " elements, "
+                          << m.num_free_dofs() << " free DOFs, " << m.num_sample_points()
+                          << " contact sample points, linear solver " << m.newton.linear_solver
+                          << (scene_.generated_stent ? ", generated stent, diameter " : ", diameter ")
+                          << m.diameter() << " mm");
+}
+
+BeamSolverParticipant::~BeamSolverParticipant() = default;
+
+void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const {
+  const BeamModel& m = *scene_.model;
+  if (!scene_.stent) return;
+  auto pos = [&](int n) { return reference ? m.reference_position(n) : m.position(n); };
+  auto diam = [&](const std::vector<int>& nodes) {
+    double s = 0;
+    for (int n : nodes) s += m.axis.project(pos(n)).r;
+    return nodes.empty() ? 0.0 : 2.0 * s / nodes.size();
+  };
+  r.distal_diameter = diam(scene_.stent->distal_nodes);
+  r.central_diameter = diam(scene_.stent->central_nodes);
+  double smin = 1e300, smax = -1e300;
+  for (int n = 0; n < m.num_nodes(); ++n) {
+    const double s = m.axis.project(pos(n)).s;
+    smin = std::min(smin, s);
+    smax = std::max(smax, s);
+  }
+  r.length = smax - smin;
+}
+
+participant::SamplePoints BeamSolverParticipant::sample_points() const {
+  const BeamModel& m = *scene_.model;
+  participant::SamplePoints sp;
+  const int n = m.num_sample_points();
+  sp.x.resize(n);
+  sp.w.resize(n);
+  sp.radius.resize(n);
+  for (int g = 0; g < n; ++g) {
+    const Vec3 x = m.sample_position(g);
+    sp.x[g] = {x.x(), x.y(), x.z()};
+    sp.w[g] = m.sample_weight(g);
+    sp.radius[g] = m.sample_radius(g);
+  }
+  return sp;
+}
+
+void BeamSolverParticipant::begin_step(int step, double time) {
+  step_ = step;
+  time_ = time;
+  step_iterations_ = 0;
+  step_residual_ = 0;
+  step_start_ = std::chrono::steady_clock::now();
+  scene_.model->set_time(time);
+  LOG_DEBUG("begin step " << step << " t = " << time);
+}
+
+participant::SolveStats BeamSolverParticipant::solve(const std::vector<participant::Vec3>& q) {
+  BeamModel& m = *scene_.model;
+  participant::SolveStats out;
+  if (!q.empty()) {
+    if (static_cast<int>(q.size()) != m.num_sample_points()) {
+      out.converged = false;
+      out.message = "expected " + std::to_string(m.num_sample_points()) + " line loads, got " +
+                    std::to_string(q.size());
+      return out;
+    }
+    std::vector<Vec3> qq(q.size());
+    for (size_t i = 0; i < q.size(); ++i) qq[i] = Vec3(q[i][0], q[i][1], q[i][2]);
+    m.set_sample_line_loads(qq);
+  } else {
+    m.set_sample_line_loads(std::vector<Vec3>(m.num_sample_points(), Vec3::Zero()));
+  }
+  NewtonStats st = m.solve();
+  newton_seconds_ += st.seconds;
+  iterations_total_ += st.iterations;
+  step_iterations_ += st.iterations;
+  step_residual_ = st.residual;
+  out.converged = st.converged;
+  out.iterations = st.iterations;
+  out.residual = st.residual;
+  out.residual_history = st.residual_history;
+  if (!st.converged) {
+    std::ostringstream os;
+    os << "beam Newton failed at step " << step_ << ", t = " << time_ << " s: " << st.message;
+    out.message = os.str();
+  }
+  if (log::enabled(log::Level::debug)) {
+    std::ostringstream os;
+    os << std::scientific << std::setprecision(2);
+    for (size_t i = 0; i < st.residual_history.size(); ++i)
+      os << (i ? " " : "") << st.residual_history[i];
+    LOG_DEBUG("beam solve step " << step_ << ": " << st.iterations << " iterations, residuals [" << os.str()
+                                 << "], " << st.seconds << " s");
+  }
+  return out;
+}
+
+void BeamSolverParticipant::end_step(bool accept) {
+  BeamModel& m = *scene_.model;
+  if (!accept) {
+    m.restore();
+    LOG_DEBUG("step " << step_ << " rejected, state restored");
+    return;
+  }
+  m.commit();
+  ++accepted_;
+  double mmax = 0;
+  for (int e = 0; e < m.num_elements(); ++e) mmax = std::max(mmax, m.bending_moment_norm(e));
+  StepRecord r{step_,
+               time_,
+               m.diameter(),
+               step_iterations_,
+               step_residual_,
+               mmax,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start_).count()};
+  stent_measures(r, false);
+  records_.push_back(r);
+  last_written_ = false;
+  if (out_ && (accepted_ % std::max(1, scene_.output_every) == 0)) {
+    out_->write_step(m, step_, time_);
+    last_written_ = true;
+  }
+  LOG_INFO("beam step " << step_ << " t = " << time_ << " s: " << r.iterations << " it, |r| = "
+                        << std::scientific << std::setprecision(2) << r.residual << std::defaultfloat
+                        << ", D = " << std::setprecision(5) << r.diameter << " mm, max |M_b| = "
+                        << std::setprecision(4) << mmax << " N mm");
+}
+
+void BeamSolverParticipant::finish() {
+  if (finished_) return;
+  finished_ = true;
+  BeamModel& m = *scene_.model;
+  if (out_) {
+    if (!last_written_ && !records_.empty()) out_->write_step(m, records_.back().step, records_.back().time);
+    out_->close();
+    const bool complete = !records_.empty() && records_.back().time >= scene_.time.end - 1e-12;
+    write_summary(run_dir_ + "/beam/summary.json", m, records_, scene_.generated_stent,
+                  complete ? "completed" : "incomplete", newton_seconds_, iterations_total_,
+                  initial_length_);
+    LOG_INFO("beam output written to " << run_dir_ << "/beam (beam.xdmf, beam.h5, summary.json)");
+  }
+}
+
+}  // namespace angio::beam

@@ -1,0 +1,340 @@
+#include "angio/beam/scene.hpp"
+
+#include <cmath>
+#include <map>
+
+namespace angio::beam {
+
+using scene::Node;
+using scene::SceneError;
+
+namespace {
+
+Vec3 v3(const std::array<double, 3>& a) { return Vec3(a[0], a[1], a[2]); }
+
+Curve to_curve(const scene::LoadCurve& c) {
+  return [c](double t) { return c.value(t); };
+}
+
+Section read_section(const Node& st) {
+  const Node mat = st.child("material", "a map {E, nu or G}");
+  mat.check_keys({"E", "nu", "G"});
+  const double E = mat.positive("E");
+  double nu = 0.3, G;
+  if (mat.has("G")) {
+    G = mat.positive("G");
+    nu = E / (2 * G) - 1;
+  } else {
+    nu = mat.in_range("nu", -0.99, 0.4999);
+    G = E / (2 * (1 + nu));
+  }
+  const Node sec = st.child("section", "a map {radius} or {A, I2, I3, J}");
+  sec.check_keys({"radius", "A", "I2", "I3", "J", "shear_factors", "contact_radius"});
+  Section s;
+  if (sec.has("radius")) {
+    const double R = sec.positive("radius");
+    double k = -1;
+    if (sec.has("shear_factors")) {
+      auto f = sec.numbers("shear_factors");
+      if (f.size() != 2 || !(f[0] > 0) || f[0] != f[1])
+        sec.child("shear_factors").fail("two equal positive shear factors for a circular section");
+      k = f[0];
+    }
+    s = circular_section(E, nu, R, k);
+  } else {
+    double k2 = 1, k3 = 1;
+    if (sec.has("shear_factors")) {
+      auto f = sec.numbers("shear_factors");
+      if (f.size() != 2 || !(f[0] > 0) || !(f[1] > 0))
+        sec.child("shear_factors").fail("two positive shear factors [k2, k3]");
+      k2 = f[0];
+      k3 = f[1];
+    }
+    s = general_section(E, G, sec.positive("A"), sec.positive("I2"), sec.positive("I3"),
+                        sec.positive("J"), k2, k3);
+  }
+  if (sec.has("contact_radius")) s.contact_radius = sec.positive("contact_radius");
+  if (auto pl = st.optional("plasticity")) {
+    pl->check_keys({"yield_moment", "tangent_modulus"});
+    if (std::abs(s.EI2 - s.EI3) > 1e-12 * s.EI2)
+      pl->fail("a circular section (I2 == I3) for bending plasticity");
+    const double My0 = pl->positive("yield_moment");
+    const double Eep = pl->non_negative("tangent_modulus");
+    if (!(Eep < E)) pl->child("tangent_modulus").fail("a value below E");
+    add_bending_plasticity(s, E, My0, Eep);
+  }
+  return s;
+}
+
+std::vector<int> node_list(const Node& n, const std::string& key, int num_nodes) {
+  std::vector<int> out;
+  const Node c = n.child(key, "a list of node indices");
+  if (c.is_scalar()) {
+    if (c.as_string() == "all") {
+      for (int i = 0; i < num_nodes; ++i) out.push_back(i);
+      return out;
+    }
+    const long v = c.as_integer();
+    if (v < -num_nodes || v >= num_nodes)
+      c.fail("a node index in [" + std::to_string(-num_nodes) + ", " + std::to_string(num_nodes - 1) + "]");
+    out.push_back(static_cast<int>(v < 0 ? v + num_nodes : v));
+    return out;
+  }
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const long v = c.at(i).as_integer();
+    if (v < -num_nodes || v >= num_nodes)
+      c.at(i).fail("a node index in [" + std::to_string(-num_nodes) + ", " + std::to_string(num_nodes - 1) +
+                   "] (negative counts from the end)");
+    out.push_back(static_cast<int>(v < 0 ? v + num_nodes : v));
+  }
+  return out;
+}
+
+std::vector<int> element_list(const Node& n, const std::string& key, int ne) {
+  std::vector<int> out;  // empty = all
+  if (!n.has(key)) return out;
+  const Node c = n.child(key);
+  if (c.is_scalar()) {
+    if (c.as_string() != "all") c.fail("'all' or a list of element indices");
+    return out;
+  }
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const long v = c.at(i).as_integer();
+    if (v < 0 || v >= ne) c.at(i).fail("an element index in [0, " + std::to_string(ne - 1) + "]");
+    out.push_back(static_cast<int>(v));
+  }
+  return out;
+}
+
+std::vector<Vec3> read_points(const Node& n) {
+  std::vector<Vec3> pts;
+  for (std::size_t i = 0; i < n.size(); ++i) pts.push_back(v3(n.at(i).as_vec3()));
+  if (pts.size() < 2) n.fail("at least two points [x, y, z]");
+  return pts;
+}
+
+}  // namespace
+
+BeamScene load_beam_scene(const std::string& path) { return beam_scene_from(scene::load_scene(path)); }
+
+BeamScene beam_scene_from(const Node& root) {
+  BeamScene bs;
+  bs.file = root.file();
+  bs.time = scene::time_settings(root);
+  if (auto out = root.optional("output")) {
+    if (out->has("every")) bs.output_every = static_cast<int>(out->integer("every", 1));
+  }
+  const scene::LoadCurves curves = scene::load_curves(root);
+  const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
+  st.check_keys({"material", "plasticity", "section", "generator", "nodes", "elements", "lines",
+                 "up", "axis", "fixation", "supports", "loads", "solver", "contact", "triads"});
+  bs.model = std::make_unique<BeamModel>();
+  BeamModel& m = *bs.model;
+  const int sec = m.add_section(read_section(st));
+
+  if (auto c = st.optional("contact")) {
+    c->check_keys({"points_per_element"});
+    m.sample_points_per_element = static_cast<int>(c->integer_or("points_per_element", 6, 1));
+    if (m.sample_points_per_element > 6) c->child("points_per_element").fail("an integer in 1..6");
+  }
+
+  std::vector<int> fixation_default;
+  if (auto g = st.optional("generator")) {
+    if (st.has("nodes") || st.has("lines")) st.fail("either generator or nodes/elements/lines, not both");
+    g->check_keys({"type", "rings", "crowns", "crimped_diameter", "strut_height", "ring_pitch",
+                   "connectors", "elements_per_strut", "elements_per_connector", "centerline", "start"});
+    g->choice("type", {"corrugated_rings"});
+    StentParameters p;
+    p.rings = static_cast<int>(g->integer_or("rings", p.rings, 1));
+    p.crowns = static_cast<int>(g->integer_or("crowns", p.crowns, 2));
+    p.crimped_diameter = g->positive_or("crimped_diameter", p.crimped_diameter);
+    p.strut_height = g->positive_or("strut_height", p.strut_height);
+    p.ring_pitch = g->positive_or("ring_pitch", p.ring_pitch);
+    p.connectors = static_cast<int>(g->integer_or("connectors", p.connectors, 0));
+    if (p.connectors > p.crowns) g->child("connectors").fail("at most `crowns` connectors");
+    p.elements_per_strut = static_cast<int>(g->integer_or("elements_per_strut", p.elements_per_strut, 1));
+    p.elements_per_connector =
+        static_cast<int>(g->integer_or("elements_per_connector", p.elements_per_connector, 1));
+    p.start = g->number_or("start", -1);
+    std::vector<Vec3> cl;
+    if (auto c = g->optional("centerline")) {
+      c->check_keys({"file", "points"});
+      if (c->has("file")) {
+        try {
+          cl = read_centerline(scene::resolve_path(*c, c->string("file")));
+        } catch (const std::runtime_error& e) {
+          c->child("file").fail(std::string("a readable centerline file (") + e.what() + ")");
+        }
+      } else {
+        cl = read_points(c->child("points", "a list of points [x, y, z]"));
+      }
+    }
+    try {
+      bs.stent = generate_corrugated_rings(p, cl);
+    } catch (const std::invalid_argument& e) {
+      g->fail(std::string("consistent stent parameters (") + e.what() + ")");
+    }
+    bs.generated_stent = true;
+    for (const auto& x : bs.stent->nodes) m.add_node(x);
+    for (size_t e = 0; e < bs.stent->elements.size(); ++e)
+      m.add_element(bs.stent->elements[e][0], bs.stent->elements[e][1], sec, bs.stent->element_up[e]);
+    m.axis.points = bs.stent->axis;
+    fixation_default = bs.stent->fixation_nodes;
+  } else if (auto ln = st.optional("lines")) {
+    // straight lines subdivided into elements; coincident end points are merged
+    Vec3 up = Vec3::Zero();
+    if (st.has("up")) up = v3(st.vec3("up"));
+    auto node_at = [&](const Vec3& x) {
+      for (int i = 0; i < m.num_nodes(); ++i)
+        if ((m.reference_position(i) - x).norm() < 1e-10) return i;
+      return m.add_node(x);
+    };
+    for (std::size_t i = 0; i < ln->size(); ++i) {
+      const Node l = ln->at(i);
+      l.check_keys({"from", "to", "elements"});
+      const Vec3 a = v3(l.vec3("from")), b = v3(l.vec3("to"));
+      const int n = static_cast<int>(l.integer("elements", 1));
+      if ((b - a).norm() <= 0) l.fail("a line of non-zero length");
+      int prev = node_at(a);
+      for (int k = 1; k <= n; ++k) {
+        const int cur = k == n ? node_at(b) : m.add_node(a + (b - a) * (static_cast<double>(k) / n));
+        m.add_element(prev, cur, sec, up);
+        prev = cur;
+      }
+    }
+  } else {
+    const Node nodes = st.child("nodes", "generator, lines or nodes/elements");
+    for (std::size_t i = 0; i < nodes.size(); ++i) m.add_node(v3(nodes.at(i).as_vec3()));
+    const Node els = st.child("elements", "a list of [node1, node2]");
+    Vec3 up = Vec3::Zero();
+    if (st.has("up")) up = v3(st.vec3("up"));
+    for (std::size_t i = 0; i < els.size(); ++i) {
+      const auto ab = els.at(i).as_numbers();
+      if (ab.size() != 2) els.at(i).fail("[node1, node2]");
+      const int a = static_cast<int>(ab[0]), b = static_cast<int>(ab[1]);
+      if (a < 0 || b < 0 || a >= m.num_nodes() || b >= m.num_nodes() || a == b ||
+          ab[0] != a || ab[1] != b)
+        els.at(i).fail("two different node indices in [0, " + std::to_string(m.num_nodes() - 1) + "]");
+      if ((m.reference_position(a) - m.reference_position(b)).norm() <= 0)
+        els.at(i).fail("an element of non-zero length");
+      m.add_element(a, b, sec, up);
+    }
+  }
+  if (m.num_elements() == 0) st.fail("at least one element");
+  const int nn = m.num_nodes();
+  const int ne = m.num_elements();
+
+  if (auto ax = st.optional("axis")) {
+    ax->check_keys({"points"});
+    m.axis.points = read_points(ax->child("points", "a list of points [x, y, z]"));
+  }
+
+  // fixation w.r.t. the device axis: radial (only radial motion), axial (axial translation
+  // fixed), circumferential (circumferential translation fixed). Values: a node list, 'auto'
+  // (generator: 4 bottom crowns of the middle ring), 'rings' (4 bottom crowns of every ring).
+  std::vector<int> ring_fixation;
+  if (bs.stent) ring_fixation = bs.stent->ring_fixation_nodes;
+  if (auto fx = st.optional("fixation")) {
+    fx->check_keys({"radial", "axial", "circumferential"});
+    for (const char* kind : {"radial", "axial", "circumferential"}) {
+      if (!fx->has(kind)) continue;
+      const Node r = fx->child(kind);
+      std::vector<int> nodes;
+      if (r.is_scalar() && (r.as_string() == "auto" || r.as_string() == "rings")) {
+        if (!bs.generated_stent) r.fail("a list of node indices ('auto'/'rings' need the stent generator)");
+        nodes = r.as_string() == "auto" ? fixation_default : ring_fixation;
+      } else if (r.is_scalar() && r.as_string() == "none") {
+      } else {
+        nodes = node_list(*fx, kind, nn);
+      }
+      for (int n : nodes) {
+        if (std::string(kind) != "axial" && m.axis.project(m.reference_position(n)).r <= 1e-12)
+          r.fail("nodes off the device axis");
+        if (std::string(kind) == "radial") m.fix_radial_only(n);
+        else if (std::string(kind) == "axial") m.fix_axial(n);
+        else m.fix_circumferential(n);
+      }
+    }
+  }
+
+  if (auto sup = st.optional("supports")) {
+    for (std::size_t i = 0; i < sup->size(); ++i) {
+      const Node s = sup->at(i);
+      s.check_keys({"nodes", "fix", "displacement", "rotation", "curve"});
+      const auto nodes = node_list(s, "nodes", nn);
+      std::array<bool, 6> f{};
+      const Node fix = s.child("fix", "'all' or a list of x, y, z, rx, ry, rz");
+      if (fix.is_scalar()) {
+        if (fix.as_string() != "all") fix.fail("'all' or a list of x, y, z, rx, ry, rz");
+        f.fill(true);
+      } else {
+        static const char* names[6] = {"x", "y", "z", "rx", "ry", "rz"};
+        for (std::size_t k = 0; k < fix.size(); ++k) {
+          const std::string d = fix.at(k).as_string();
+          int idx = -1;
+          for (int q = 0; q < 6; ++q)
+            if (d == names[q]) idx = q;
+          if (idx < 0) fix.at(k).fail("one of x, y, z, rx, ry, rz");
+          f[idx] = true;
+        }
+      }
+      const Curve c = to_curve(scene::curve_ref(s, "curve", curves));
+      for (int n : nodes) {
+        m.fix(n, f);
+        if (s.has("displacement")) {
+          const Vec3 u = v3(s.vec3("displacement"));
+          for (int k = 0; k < 3; ++k)
+            if (u(k) != 0.0) {
+              if (!f[k]) s.child("displacement").fail("non-zero values only on fixed directions");
+              m.prescribed_displacements.push_back({n, k, u(k), c});
+            }
+        }
+        if (s.has("rotation")) {
+          if (!(f[3] && f[4] && f[5])) s.child("rotation").fail("rx, ry and rz all fixed for a prescribed rotation");
+          m.prescribed_rotations.push_back({n, v3(s.vec3("rotation")), c});
+        }
+      }
+    }
+  }
+
+  if (auto loads = st.optional("loads")) {
+    for (std::size_t i = 0; i < loads->size(); ++i) {
+      const Node l = loads->at(i);
+      const std::string type = l.choice("type", {"nodal", "line", "radial_line"});
+      const Curve c = to_curve(scene::curve_ref(l, "curve", curves));
+      if (type == "nodal") {
+        l.check_keys({"type", "nodes", "force", "moment", "curve"});
+        Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+        if (l.has("force")) F = v3(l.vec3("force"));
+        if (l.has("moment")) M = v3(l.vec3("moment"));
+        for (int n : node_list(l, "nodes", nn)) m.nodal_loads.push_back({n, F, M, c});
+      } else if (type == "line") {
+        l.check_keys({"type", "elements", "q", "curve"});
+        m.line_loads.push_back({element_list(l, "elements", ne), v3(l.vec3("q")), c});
+      } else {
+        l.check_keys({"type", "elements", "magnitude", "curve", "follower"});
+        m.radial_loads.push_back(
+            {element_list(l, "elements", ne), l.number("magnitude"), c, l.boolean_or("follower", false)});
+      }
+    }
+  }
+
+  if (auto so = st.optional("solver")) {
+    so->check_keys({"linear_solver", "max_iterations", "residual_tol", "residual_rel_tol",
+                    "increment_tol", "line_search"});
+    m.newton.linear_solver = so->choice_or("linear_solver", {"umfpack", "klu", "sparselu"}, "klu");
+    m.newton.max_iterations = static_cast<int>(so->integer_or("max_iterations", 30, 1));
+    m.newton.residual_tol = so->positive_or("residual_tol", m.newton.residual_tol);
+    m.newton.residual_rel_tol = so->non_negative_or("residual_rel_tol", m.newton.residual_rel_tol);
+    m.newton.increment_tol = so->positive_or("increment_tol", m.newton.increment_tol);
+    m.newton.line_search = so->boolean_or("line_search", false);
+  }
+  try {
+    m.finalize();
+  } catch (const std::invalid_argument& e) {
+    st.fail(std::string("a consistent model (") + e.what() + ")");
+  }
+  return bs;
+}
+
+}  // namespace angio::beam
