@@ -78,8 +78,9 @@ def int_setting(scene, section, key, default, scene_path):
 
 
 class Proc:
-    def __init__(self, name, cmd, log_path):
+    def __init__(self, name, cmd, log_path, echo_all=True):
         self.name = name
+        self.echo_all = echo_all
         self.cmd = cmd
         self.log = open(log_path, "w")
         # Own process group: Ctrl-C reaches the launcher only, which forwards it deliberately.
@@ -90,8 +91,11 @@ class Proc:
 
     def _pump(self):
         for line in self.p.stdout:
-            sys.stdout.write(line)
-            sys.stdout.flush()
+            # In coupled runs the coupler's line per step is the progress; participants show
+            # only their warnings and errors on the terminal (everything is in their log file).
+            if self.echo_all or "WARN" in line or "ERROR" in line or "rror" in line:
+                sys.stdout.write(line)
+                sys.stdout.flush()
             self.log.write(line)
             self.log.flush()
 
@@ -125,6 +129,8 @@ def main():
     ap.add_argument("--record", action="store_true", help="record all exchanges (coupled scenes)")
     ap.add_argument("--timeout", type=float, default=600.0, help="peer silence timeout, s")
     ap.add_argument("--log-level", default="info", choices=["debug", "info", "warn", "error"])
+    ap.add_argument("--verbose", action="store_true",
+                    help="show every participant's output on the terminal (default: coupler only)")
     ap.add_argument("--run-id", help="run id (default: random); replays need the recorded one")
     ap.add_argument("--beam-cmd", help="replace the beam participant executable (same CLI)")
     ap.add_argument("--solid-cmd", help="replace the solid participant executable (same CLI)")
@@ -180,7 +186,8 @@ def main():
     t0 = time.time()
     for name, cmd in plan:
         try:
-            procs.append(Proc(name, cmd, run_dir / f"{name}.log"))
+            echo = args.verbose or len(plan) == 1 or name == "coupler"
+            procs.append(Proc(name, cmd, run_dir / f"{name}.log", echo_all=echo))
         except OSError as e:
             stop_all(procs)
             die(f"cannot start {name} ({' '.join(cmd[:1])}): {e.strerror}", code=10 + len(procs))

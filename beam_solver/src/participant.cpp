@@ -146,7 +146,8 @@ void BeamSolverParticipant::end_step(bool accept) {
   LOG_INFO("beam step " << step_ << " t = " << time_ << " s: " << r.iterations << " it, |r| = "
                         << std::scientific << std::setprecision(2) << r.residual << std::defaultfloat
                         << ", D = " << std::setprecision(5) << r.diameter << " mm, max |M_b| = "
-                        << std::setprecision(4) << mmax << " N mm");
+                        << std::setprecision(4) << mmax << " N mm, " << std::setprecision(3)
+                        << r.wall_seconds << " s");
 }
 
 void BeamSolverParticipant::finish() {

@@ -40,7 +40,8 @@ int run(const scene::TimeSettings& time, const std::function<void(int, double)>&
       end(true);
       const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      LOG_INFO("step " << stepper.step() << " t = " << stepper.time() << " s: " << s.iterations
+      // The participant logs its own line per committed step (with its physical measures).
+      LOG_DEBUG("step " << stepper.step() << " t = " << stepper.time() << " s: " << s.iterations
                        << " Newton iterations, residual " << s.residual << ", " << wall << " s");
       stepper.accept();
     }
