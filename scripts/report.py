@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 # Paper values (DESIGN §4) for the straight free expansion, shown next to ours.
 PAPER = {"diameter_initial": 1.15, "diameter_max": 2.59, "diameter_final": 2.31,
-         "recoil": 0.28, "recoil_percent": 10.8}
+         "recoil": 0.28, "recoil_percent": 10.8, "dogboning_percent": 20.4}
 
 
 def load_json(p):
@@ -49,6 +49,13 @@ def main(run_dir):
                  ("stent diameter final (mm)", d["final"], PAPER["diameter_final"]),
                  ("elastic recoil (mm)", d["recoil"], PAPER["recoil"]),
                  ("elastic recoil (%)", d["recoil_percent"], PAPER["recoil_percent"])]
+        st = beam.get("stent")
+        if st:
+            out["stent"].update(st)
+            rows += [("dogboning max (%)", st["dogboning_max_percent"], PAPER["dogboning_percent"]),
+                     ("  at time (s)", st["time_of_dogboning_max"], None),
+                     ("foreshortening at max diameter (%)", st["foreshortening_at_max_diameter_percent"], None),
+                     ("foreshortening final (%)", st["foreshortening_final_percent"], None)]
     if solid:
         out["solid"] = {k: v for k, v in solid.items() if k != "steps"}
         for k, v in solid.items():
