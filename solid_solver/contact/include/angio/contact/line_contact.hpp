@@ -1,0 +1,93 @@
+// Line-to-surface penalty contact: beam (stent) sample points against solid surfaces (DESIGN.md §2).
+//
+// Per beam sample point x (weight w = arc length, mm; beam contact radius R) and surface:
+//   s, n   closest point on the surface and unit contact normal toward the beam
+//   g    = (x - s) . n - R,   <g> = min(g, 0),   Pi = w eps/2 <g>^2
+//   q    = -eps <g> n                    line load on the BEAM (N/mm), pushes the beam away from the surface
+//   f_a  = -w q N_a(xi)                  force on solid face node a (N), equal and opposite
+// Solid assembly (r = f_int - f_ext convention of angio::solid): r_a += dPi/dX_a = -f_a,
+//   K_ab += d2Pi/dX_a dX_b  (beam point x held fixed; includes the variation of the closest point and of n).
+#pragma once
+#include <vector>
+
+#include "angio/contact/search.hpp"
+
+namespace angio::contact {
+
+struct BeamPoint {
+  Vec3 x = Vec3::Zero();  // position (mm)
+  double w = 0.0;         // integration weight along the centreline (mm)
+  double R = 0.0;         // beam contact radius (mm)
+};
+
+struct LineContactParams {
+  double penalty = 10.0;         // eps (N/mm^2), paper value for stent-balloon and stent-artery
+  bool compute_tangent = true;   // fill NodalContribution::K
+  bool beam_tangent = false;     // fill PointContact::dq_dx
+  ProjectionOptions projection;
+};
+
+// Nodal residual/tangent contribution of one contact point (or Gauss point) to the solid.
+struct NodalContribution {
+  std::vector<int> nodes;   // node ids (as in the faces), 3 dofs each, dof = 3*local + component
+  Eigen::VectorXd r;        // dPi/dX  (= minus the contact forces on these nodes), size 3*nodes
+  Eigen::MatrixXd K;        // d2Pi/dX2 = dr/dX (symmetric), empty if no tangent requested
+  int surface = -1;         // line contact: index of the surface; surface contact: pass (0, or 1 if two_pass)
+  int point = -1;           // line contact: beam point index; surface contact: index into SurfaceContactResult::points
+};
+
+// One beam point against one surface.
+struct PointContact {
+  bool found = false;       // a face within the search radius
+  bool active = false;      // g < 0
+  int face = -1;
+  Projection proj;          // s, n (toward the beam), xi, location
+  double gap = 0.0;         // g = (x - s).n - R (only if found)
+  Vec3 q = Vec3::Zero();    // line load on the beam (N/mm)
+  Mat3 dq_dx = Mat3::Zero();// dq/dx with the surface fixed (if beam_tangent)
+};
+
+struct ContactDiagnostics {
+  int num_points = 0;        // evaluated (point, surface) pairs with a closest point in range
+  int num_active = 0;        // with g < 0
+  double min_gap = std::numeric_limits<double>::infinity();  // smallest gap (most negative = largest penetration)
+  Vec3 force_on_solid = Vec3::Zero();  // sum of nodal forces on the solid (N)
+  double force_magnitude = 0.0;        // sum over points of |force| (N)
+  double energy = 0.0;                 // penalty potential Pi (N mm); r = dPi/dX
+  void merge(const ContactDiagnostics& o);
+};
+
+struct LineContactResult {
+  std::vector<Vec3> q;                                // per point: line load on the beam summed over surfaces
+  Vec3 force_on_beam = Vec3::Zero();                  // sum_i w_i q_i (N) = -diag.force_on_solid
+  std::vector<std::vector<PointContact>> per_surface; // [surface][point]
+  std::vector<NodalContribution> solid;               // active (point, surface) pairs
+  ContactDiagnostics diag;
+};
+
+// Robin-mode data per beam point (DESIGN.md §2): the beam linearizes q(x) = -eps <(x - s).n - R> n.
+// A point can see several surfaces; only one plane per point is representable, so the surface with the
+// smallest gap g among those with a closest point in range is reported (the line loads q above stay the exact
+// sum). found = false: no surface within the search radius (s, n zero).
+struct RobinPoint {
+  bool found = false;
+  bool active = false;    // g < 0
+  int surface = -1;
+  Vec3 s = Vec3::Zero();
+  Vec3 n = Vec3::Zero();  // unit normal toward the beam
+  double gap = 0.0;
+  double penalty = 0.0;   // eps
+};
+std::vector<RobinPoint> robin_points(const LineContactResult& res, double penalty);
+
+// Evaluate one point against one face whose closest point is already known (pure kernel).
+// Returns the contribution on the face nodes (r, K as documented above) and fills pc.gap, pc.q, pc.active.
+void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, double normal_sign, const Projection& proj,
+                       const LineContactParams& par, PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K);
+
+// Evaluate all points against all surfaces (searches must be update()d with the current coordinates).
+// The contributions of different surfaces add up (a point may touch balloon and artery at the same time).
+LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::span<const SurfaceSearch* const> surfaces,
+                                        const LineContactParams& par);
+
+}  // namespace angio::contact

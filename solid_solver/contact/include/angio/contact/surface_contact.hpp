@@ -1,0 +1,57 @@
+// Surface-to-surface frictionless penalty contact (balloon outer surface -> artery endothelium),
+// Gauss-point-to-segment: Gauss points on the slave faces, closest-point projection onto the master.
+//
+// Per slave Gauss point x = sum_a N_a(xi_g) X^s_a with weight W = w_g j(xi_g) (CURRENT area, j = |x_,xi x x_,eta|):
+//   s, n = closest point on the master surface and its contact normal (toward the slave)
+//   g_N  = (x - s) . n,    Pi = W eps/2 <g_N>^2,    traction on the slave t = -eps <g_N> n (pressure p = -eps <g_N>)
+//   r    = dPi/du, K = d2Pi/du2 with u = [slave face nodes, master face nodes]
+// (includes the variation of the current area, of the closest point and of the master normal).
+// Forces on the nodes are -r; slave and master forces balance exactly.
+#pragma once
+#include <vector>
+
+#include "angio/contact/line_contact.hpp"
+
+namespace angio::contact {
+
+struct SurfaceContactParams {
+  double penalty = 5.0;          // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see README
+  int quadrature_degree = 3;     // slave quadrature (face_rule): quad 2x2, tri 6 points
+  bool two_pass = false;         // symmetric: both surfaces act as slave, each pass with eps/2
+  bool compute_tangent = true;
+  ProjectionOptions projection;
+};
+
+struct GaussPointContact {
+  int pass = 0;            // 0: slave->master, 1: master->slave (two_pass)
+  int slave_face = -1, master_face = -1;
+  int gauss_point = -1;    // index in the slave face rule
+  Vec3 x = Vec3::Zero();   // Gauss point
+  Vec3 s = Vec3::Zero();   // closest point on the master
+  Vec3 n = Vec3::Zero();   // master contact normal
+  double gap = 0.0;        // g_N
+  double pressure = 0.0;   // -eps <g_N> (MPa)
+  double area = 0.0;       // W = w_g j (mm^2)
+  bool active = false;
+  Location location = Location::Interior;
+};
+
+struct SurfaceContactResult {
+  std::vector<NodalContribution> contributions;  // active Gauss points; nodes = slave face nodes then master face nodes
+  std::vector<GaussPointContact> points;         // every slave Gauss point with a master point in the search radius
+  ContactDiagnostics diag;                       // force_on_solid = net force on the master surface (pass 0)
+  double active_area = 0.0;                      // sum of W over active Gauss points
+};
+
+// Pure kernel for one slave Gauss point whose master projection is known.
+// r (3(ns+nm)) and K (if non-null) are overwritten; returns g_N.
+double surface_gp_kernel(FaceKind slave_kind, const FaceX& Xs, const Vec2& xi_g, double w_g, FaceKind master_kind,
+                         const FaceX& Xm, double master_sign, const Projection& proj, double penalty,
+                         Eigen::VectorXd& r, Eigen::MatrixXd* K);
+
+// Evaluate contact of `slave` against `master` (both searches update()d with the current coordinates;
+// the master's radius is the search radius; the slave's search is used only as master in pass 1).
+SurfaceContactResult evaluate_surface_contact(const SurfaceSearch& slave, const SurfaceSearch& master,
+                                              const SurfaceContactParams& par);
+
+}  // namespace angio::contact

@@ -1,0 +1,102 @@
+#include "angio/contact/line_contact.hpp"
+
+#include <cmath>
+
+namespace angio::contact {
+
+void ContactDiagnostics::merge(const ContactDiagnostics& o) {
+  num_points += o.num_points;
+  num_active += o.num_active;
+  min_gap = std::min(min_gap, o.min_gap);
+  force_on_solid += o.force_on_solid;
+  force_magnitude += o.force_magnitude;
+  energy += o.energy;
+}
+
+void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, double normal_sign, const Projection& proj,
+                       const LineContactParams& par, PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K) {
+  const int nn = num_nodes(kind);
+  pc.proj = proj;
+  pc.gap = proj.d - bp.R;
+  pc.active = pc.gap < 0.0;
+  pc.q.setZero();
+  pc.dq_dx.setZero();
+  r.setZero(3 * nn);
+  if (K) K->setZero(3 * nn, 3 * nn);
+  if (!pc.active) return;
+  const double eps = par.penalty, g = pc.gap, w = bp.w;
+  pc.q = -eps * g * proj.n;
+  const bool need_h = K != nullptr || par.beam_tangent;
+  GapLinearization L;
+  linearize(kind, X, normal_sign, bp.x, proj, need_h, L);
+  // Pi = w eps/2 g^2 ; dPi/du = w eps g dd ; d2Pi/du2 = w eps (dd^T dd + g hd), u = [x, X]
+  const int m = L.m;
+  r = w * eps * g * L.dd.segment(3, m - 3).transpose();
+  if (K) {
+    const Eigen::RowVectorXd dX = L.dd.segment(3, m - 3);
+    *K = w * eps * (dX.transpose() * dX + g * L.hd.bottomRightCorner(m - 3, m - 3));
+  }
+  if (par.beam_tangent) {
+    // q = -eps g n: dq/dx = -eps (n dd_x + g dn_x)
+    pc.dq_dx = -eps * (proj.n * L.dd.segment<3>(0) + g * L.dn.leftCols<3>());
+  }
+}
+
+LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::span<const SurfaceSearch* const> surfaces,
+                                        const LineContactParams& par) {
+  LineContactResult res;
+  res.q.assign(points.size(), Vec3::Zero());
+  res.per_surface.resize(surfaces.size());
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const SurfaceSearch& S = *surfaces[k];
+    const Surface& surf = S.surface();
+    auto& pcs = res.per_surface[k];
+    pcs.assign(points.size(), PointContact{});
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const BeamPoint& bp = points[i];
+      const SurfaceProjection sp = S.closest(bp.x, par.projection);
+      PointContact& pc = pcs[i];
+      if (!sp.found) continue;
+      pc.found = true;
+      pc.face = sp.face;
+      const Face& face = surf.faces[sp.face];
+      NodalContribution nc;
+      line_point_kernel(bp, face.kind, S.face_coords(sp.face), surf.normal_sign, sp.proj, par, pc, nc.r,
+                        par.compute_tangent ? &nc.K : nullptr);
+      ++res.diag.num_points;
+      res.diag.min_gap = std::min(res.diag.min_gap, pc.gap);
+      if (!pc.active) continue;
+      ++res.diag.num_active;
+      res.q[i] += pc.q;
+      res.force_on_beam += bp.w * pc.q;
+      res.diag.force_on_solid -= bp.w * pc.q;
+      res.diag.force_magnitude += bp.w * pc.q.norm();
+      res.diag.energy += 0.5 * bp.w * par.penalty * pc.gap * pc.gap;
+      nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + face.nn());
+      nc.surface = static_cast<int>(k);
+      nc.point = static_cast<int>(i);
+      res.solid.push_back(std::move(nc));
+    }
+  }
+  return res;
+}
+
+std::vector<RobinPoint> robin_points(const LineContactResult& res, double penalty) {
+  std::vector<RobinPoint> out(res.q.size());
+  for (std::size_t k = 0; k < res.per_surface.size(); ++k)
+    for (std::size_t i = 0; i < out.size() && i < res.per_surface[k].size(); ++i) {
+      const PointContact& pc = res.per_surface[k][i];
+      if (!pc.found || (out[i].found && pc.gap >= out[i].gap)) continue;
+      RobinPoint& rp = out[i];
+      rp.found = true;
+      rp.active = pc.active;
+      rp.surface = static_cast<int>(k);
+      rp.s = pc.proj.s;
+      rp.n = pc.proj.n;
+      rp.gap = pc.gap;
+      rp.penalty = penalty;
+    }
+  return out;
+}
+
+}  // namespace angio::contact
