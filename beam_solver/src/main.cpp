@@ -40,11 +40,7 @@ int main(int argc, char** argv) {
     if (endpoint && !endpoint->empty()) {
       // ---- co-simulation: serve the beam role to the coupler ----
 #ifdef ANGIO_HAVE_ROLE_SERVER
-      angio::participant::ServeOptions o;
-      o.endpoint = *endpoint;
-      o.run_id = cli.get("run-id");
-      o.timeout = std::chrono::milliseconds(static_cast<long>(1000.0 * cli.number("timeout")));
-      o.software = "beam_solver 0.1";
+      const auto o = angio::participant::serve_options(cli, "beam_solver 0.1");
       return angio::participant::serve(beam, o);
 #else
       LOG_ERROR("this beam_solver was built without the zenoh transport; --endpoint unsupported");

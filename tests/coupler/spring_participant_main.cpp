@@ -19,11 +19,7 @@ int main(int argc, char** argv) {
     if (!args.parse(argc, argv)) return 0;
     const std::string role = args.get("role");
     cli::setup_logging(args, "spring-" + role);
-    participant::ServeOptions o;
-    o.endpoint = args.get("endpoint");
-    o.run_id = args.get("run-id");
-    o.timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
-    o.software = "spring_participant";
+    const participant::ServeOptions o = participant::serve_options(args, "spring_participant");
     const double delay = args.number("delay");
     if (role == "beam") {
       test::SpringBeam beam;

@@ -91,6 +91,15 @@ msg::Buffer common(const fb::Envelope& env, const msg::Header& h, bool& stop,
 
 }  // namespace
 
+ServeOptions serve_options(const cli::Parser& args, std::string software) {
+  ServeOptions o;
+  o.endpoint = args.get("endpoint");
+  o.run_id = args.get("run-id");
+  o.timeout = std::chrono::milliseconds(static_cast<long>(1000.0 * args.number("timeout")));
+  o.software = std::move(software);
+  return o;
+}
+
 int serve(BeamParticipant& beam, const ServeOptions& o) {
   return serve_role(fb::Role::Beam, o, [&](const fb::Envelope& env, const msg::Header& h, bool& stop) {
     switch (env.payload_type()) {

@@ -24,11 +24,9 @@ int main(int argc, char** argv) {
     if (role != "beam" && role != "solid")
       throw cli::UsageError("--role: expected beam or solid, got '" + role + "'");
     const auto rec = recording::read(args.get("recording"));
-    participant::ServeOptions o;
-    o.endpoint = args.get("endpoint");
-    o.run_id = args.has("run-id") ? args.get("run-id") : rec.run_id;
-    o.timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
-    o.software = "replay_participant (" + args.get("recording") + ")";
+    participant::ServeOptions o =
+        participant::serve_options(args, "replay_participant (" + args.get("recording") + ")");
+    if (!args.has("run-id")) o.run_id = rec.run_id;
     const double tol = args.number("tolerance");
     if (role == "beam") {
       replay::ReplayBeam beam(rec, tol);

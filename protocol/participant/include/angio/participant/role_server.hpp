@@ -6,6 +6,7 @@
 #include <chrono>
 #include <string>
 
+#include "angio/common/cli.hpp"
 #include "angio/participant/beam_participant.hpp"
 #include "angio/participant/solid_participant.hpp"
 
@@ -17,6 +18,9 @@ struct ServeOptions {
   std::chrono::milliseconds timeout{600000};  // longest silence from the coupler before giving up
   std::string software;  // name/version sent in the handshake
 };
+
+// Options from the common command line (--endpoint, --run-id, --timeout) of a participant.
+ServeOptions serve_options(const cli::Parser& args, std::string software);
 
 // Exit codes of serve(): 0 after a Shutdown request; 4 when the coupler disappeared or stayed
 // silent longer than the timeout; 5 when the transport could not be opened.
