@@ -1,0 +1,61 @@
+// The scene's top-level `contact:` section and the contact objects of a SolidRunner.
+//
+//   contact:
+//     stent_balloon: {penalty: 10.0}               # N/mm^2, line-to-surface (paper §2.5); or `off`
+//     stent_artery: {penalty: 10.0}                # N/mm^2; or `off`
+//     balloon_artery: {penalty: 5.0, quadrature: 3, two_pass: false}   # N/mm^3 (README of solid_contact); or `off`
+//     search_radius: 0.3                           # mm (> beam radius + largest penetration)
+//     log: true                                    # one line per converged solid solve (rank 0)
+//
+// Defaults (section or entry absent): the paper's values for the contact pairs whose surfaces exist
+// (stent-balloon / stent-artery 10 N/mm^2, balloon-artery 5 when both balloon and artery are meshed).
+#pragma once
+#include <memory>
+#include <optional>
+
+#include "angio/scene/node.hpp"
+#include "angio/solid/stent_contact.hpp"
+
+namespace angio::solid {
+
+struct ContactSpec {
+  std::optional<double> stent_balloon = 10.0;  // N/mm^2, unset: off
+  std::optional<double> stent_artery = 10.0;
+  std::optional<PenaltySurfaceContact::Options> balloon_artery = PenaltySurfaceContact::Options{};
+  double search_radius = 0.3;
+  bool log = true;
+};
+
+// Throws scene::SceneError ("file: contact.key: expected ...").
+ContactSpec read_contact_spec(const scene::Node& root);
+
+// Owns the contact models of one runner; registered with runner.set_stent_contact() on construction and
+// unregistered on destruction (keep it alive as long as the runner solves).
+class ContactSetup {
+ public:
+  ContactSetup(SolidRunner& runner, const ContactSpec& spec);
+  ~ContactSetup();
+  ContactSetup(const ContactSetup&) = delete;
+  ContactSetup& operator=(const ContactSetup&) = delete;
+
+  PenaltyStentContact* stent() { return stent_.get(); }
+  PenaltySurfaceContact* balloon_artery() { return balloon_artery_.get(); }
+  CompositeContact& composite() { return composite_; }
+  // Seconds spent in contact add() (search + evaluation + insertion) over all assemblies so far.
+  double contact_seconds() const;
+  // Sum of SolveReport::total_seconds of the converged solves seen by the reply hook.
+  double solve_seconds() const { return solve_seconds_; }
+
+ private:
+  SolidRunner& runner_;
+  std::unique_ptr<PenaltyStentContact> stent_;
+  std::unique_ptr<PenaltySurfaceContact> balloon_artery_;
+  CompositeContact composite_;
+  double solve_seconds_ = 0.0;
+  double contact_seconds_at_last_ = 0.0;
+};
+
+// Reads the `contact:` section and builds/registers the contact of a runner. Collective (all ranks).
+std::unique_ptr<ContactSetup> make_contact(const scene::Node& root, SolidRunner& runner);
+
+}  // namespace angio::solid

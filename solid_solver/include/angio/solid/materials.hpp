@@ -1,0 +1,80 @@
+// Pure constitutive kernels for the solid solver (no MPI, no PETSc).
+// Units: mm, N, MPa. Voigt order for symmetric tensors: 11, 22, 33, 12, 23, 13; strain-like
+// Voigt vectors use engineering shear (2 E12), so that dS_voigt = D dE_voigt with D = 2 dS/dC.
+#pragma once
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+namespace angio::solid {
+
+using Mat3 = Eigen::Matrix3d;
+using Vec3d = Eigen::Vector3d;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+inline constexpr int kVoigt[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+
+Vec6 to_voigt_stress(const Mat3& S);
+Mat3 from_voigt_stress(const Vec6& s);
+
+// Compressible Neo-Hooke (4C "coupled Neo-Hooke"):
+//   Psi = mu/2 (I1 - 3) + mu/(2 beta) (J^(-2 beta) - 1), mu = E/(2(1+nu)), beta = nu/(1-2nu)
+//   (beta = 0: volumetric term -mu ln J).
+//   S = mu (I - J^(-2beta) C^-1),  D = 2 mu beta J^(-2beta) C^-1 (x) C^-1 + 2 mu J^(-2beta) I_{C^-1}
+struct NeoHooke {
+  double E = 1.0;
+  double nu = 0.0;
+  double mu() const { return E / (2.0 * (1.0 + nu)); }
+  double beta() const { return nu / (1.0 - 2.0 * nu); }
+};
+double energy(const NeoHooke& m, const Mat3& C);
+// Adds S and D (D may be null).
+void add_stress(const NeoHooke& m, const Mat3& C, Mat3& S, Mat6* D);
+
+// One exponential fiber family (Holzapfel-Gasser-Ogden without dispersion), tension only:
+//   Psi = k1/(2 k2) (exp(k2 (I4 - 1)^2) - 1) if I4 > 1, else 0,   I4 = a0 . C a0 (|a0| = 1)
+struct FiberFamily {
+  double k1 = 0.0;
+  double k2 = 0.0;
+  Vec3d a0 = Vec3d::UnitX();
+};
+double energy(const FiberFamily& f, const Mat3& C);
+void add_stress(const FiberFamily& f, const Mat3& C, Mat3& S, Mat6* D);
+
+// Fiber family specification relative to a local frame (circumferential e_c, axial e_a, radial
+// e_r): direction a0 = cos(phi) e_c + sin(phi) e_a, phi in degrees from circumferential toward
+// axial. `pair` adds the mirrored family at -phi (two families as in the paper's appendix B).
+struct FiberSpec {
+  double k1 = 0.0;
+  double k2 = 0.0;
+  double angle_deg = 0.0;
+  bool pair = false;
+};
+
+// A layer / block material: Neo-Hooke ground matrix plus fiber families.
+struct LayerMaterial {
+  std::string name;
+  NeoHooke matrix;
+  std::vector<FiberSpec> fibers;
+};
+
+// Local material frame of an element.
+struct Frame {
+  Vec3d circumferential = Vec3d::UnitX();
+  Vec3d axial = Vec3d::UnitZ();
+  Vec3d radial = Vec3d::UnitY();
+};
+
+// Concrete fiber families of one element (directions resolved from the frame).
+std::vector<FiberFamily> resolve_fibers(const LayerMaterial& m, const Frame& frame);
+
+// Total energy, stress and tangent of a layer material at a material point with resolved fibers.
+double energy(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C);
+void stress_tangent(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C, Mat3& S,
+                    Mat6* D);
+
+// First principal Cauchy stress and its direction from F and S (sigma = F S F^T / J).
+void first_principal_cauchy(const Mat3& F, const Mat3& S, double& s1, Vec3d& dir);
+
+}  // namespace angio::solid

@@ -1,0 +1,97 @@
+// Solid meshes: element blocks (one material each), surface sets (pressure, springs, contact),
+// node sets; built-in tube generator and gmsh .msh v4 ASCII reader.
+#pragma once
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "angio/solid/elements.hpp"
+
+namespace angio::solid {
+
+struct Element {
+  ElemType type = ElemType::Hex8;
+  int block = 0;              // index into Mesh::blocks
+  std::array<int, 10> n{};    // node indices (first num_nodes(type) used)
+  int nn() const { return num_nodes(type); }
+};
+
+struct Face {
+  FaceType type = FaceType::Quad4;
+  std::array<int, 6> n{};
+  int nn() const { return num_nodes(type); }
+};
+
+struct Block {
+  std::string name;   // e.g. "balloon", "media", "adventitia"
+  std::string part;   // "balloon" or "artery" (used for summaries)
+};
+
+struct SurfaceSet {
+  std::string name;   // e.g. "balloon_inner", "artery_endo", "artery_end0"
+  std::vector<Face> faces;
+};
+
+// Straight axis used to build local frames (circumferential/axial/radial) per element.
+struct Axis {
+  Vec3d origin = Vec3d::Zero();
+  Vec3d direction = Vec3d::UnitZ();
+};
+
+struct Mesh {
+  std::vector<Vec3d> X;
+  std::vector<Element> elements;
+  std::vector<Block> blocks;
+  std::vector<SurfaceSet> surfaces;
+  std::map<std::string, std::vector<int>> node_sets;
+  // Optional local material frame per element (fiber directions); empty: built from the model's axis.
+  std::vector<Frame> frames;
+
+  int block_index(const std::string& name) const;     // -1 if absent
+  const SurfaceSet* surface(const std::string& name) const;
+  // Append another mesh (node/element indices shifted, names kept).
+  void append(const Mesh& other);
+  // Orient every surface face so that its normal points out of the adjacent volume element.
+  // Throws if a face has no adjacent element.
+  void orient_surfaces();
+};
+
+// Structured hex8 tube: layers from inside to outside; blocks named after the layers,
+// surfaces <prefix>inner, <prefix>outer, <prefix>end0 (z = z0), <prefix>end1 (z = z0 + length).
+// Axis along +z through `center`, the tube spans z in [center.z - L/2, center.z + L/2].
+struct TubeLayer {
+  std::string name;
+  double thickness = 0.0;
+  int n_radial = 1;
+};
+struct TubeSpec {
+  std::string part;            // "balloon" / "artery"
+  std::string surface_prefix;  // e.g. "balloon_"
+  double length = 1.0;
+  double inner_radius = 1.0;
+  std::vector<TubeLayer> layers;
+  int n_circ = 16;
+  int n_axial = 8;
+  Vec3d center = Vec3d::Zero();
+};
+Mesh make_tube(const TubeSpec& spec);
+
+// gmsh .msh 4.x ASCII. Volume physical groups become blocks (name = physical name, or
+// "volume_<tag>"), surface physical groups become surface sets. Supported element types:
+// hex8 (5), tet4 (4), tet10 (11), quad4 (3), tri3 (2), tri6 (9); others are ignored.
+// Coordinates are multiplied by `scale`. Throws std::runtime_error("file:line: ...") on bad input.
+Mesh read_gmsh(const std::string& path, const std::string& part, const std::string& surface_prefix,
+               double scale = 1.0);
+
+// Local frame of an element from a straight axis (element centroid, reference geometry).
+Frame element_frame(const Mesh& m, int e, const Axis& axis);
+// Fill m.frames for every element from a straight axis.
+void set_frames_from_axis(Mesh& m, const Axis& axis);
+// Fill m.frames from a polyline centerline (>= 2 points): axial = tangent of the closest segment,
+// radial = centroid minus its closest point (without the axial part), circumferential = axial x radial.
+void set_frames_from_centerline(Mesh& m, const std::vector<Vec3d>& centerline);
+Vec3d element_centroid(const Mesh& m, int e);
+
+}  // namespace angio::solid

@@ -1,0 +1,159 @@
+// Distributed quasi-static total-Lagrangian solid model (PETSc + MPI).
+//
+// Every rank holds the whole (reference) mesh. Elements are partitioned (contiguous blocks or a
+// PETSc MatPartitioning of the element dual graph); each node is owned by the lowest rank among
+// its elements and nodes are renumbered so that every rank owns one contiguous block of DOFs
+// (3 per node, interlaced). Each rank assembles its own elements into an MPIAIJ matrix
+// (block size 3, preallocated) and a residual vector. The total displacement is kept as a full
+// copy on every rank (VecScatterCreateToAll after each Newton update).
+#pragma once
+#include <mpi.h>
+#include <petscksp.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "angio/solid/mesh.hpp"
+
+namespace angio::solid {
+
+class SolidModel;
+
+// Hook for contact (stent line-to-surface, balloon-artery surface-to-surface; a later issue).
+// Called collectively from every assembly with the current configuration; implementations add
+// their residual (r = f_int - f_ext convention) and, if K is non-null, tangent contributions with
+// VecSetValues/MatSetValues(ADD_VALUES) using model.dof(node, component) global indices.
+class ContactModel {
+ public:
+  virtual ~ContactModel() = default;
+  virtual void add(const SolidModel& model, Vec r, Mat K) = 0;
+};
+
+struct NewtonOptions {
+  int max_iterations = 30;
+  double rtol = 1e-8;        // ||r|| <= rtol * ||r_0|| (r_0: first residual of the solve)
+  double atol = 1e-9;        // or ||r|| <= atol (N)
+  bool line_search = true;   // backtracking on ||r|| (halving, up to max_line_search times)
+  int max_line_search = 6;
+  bool verbose = false;      // per-iteration log on rank 0
+};
+
+struct ModelOptions {
+  std::string partitioner = "contiguous";  // "contiguous" or a MatPartitioning type (ptscotch, parmetis, average...)
+  std::string petsc_options;               // appended after the defaults (GMRES(200) + block-Jacobi ILU(1))
+  NewtonOptions newton;
+  Axis axis;                               // fiber frames if the mesh has none
+};
+
+struct SolveReport {
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;
+  std::vector<double> residual_history;
+  std::string message;
+  int linear_iterations = 0;
+  double assembly_seconds = 0.0;
+  double linear_seconds = 0.0;
+  double total_seconds = 0.0;
+};
+
+struct PressureLoad {
+  std::string surface;
+  std::function<double(double)> pressure;  // p(t) in MPa, acting against the face normal (outward of the body)
+};
+struct SpringSupport {
+  std::string surface;
+  double stiffness = 0.0;  // N/mm^3 (per unit reference area)
+};
+struct DirichletBC {
+  std::vector<int> nodes;
+  int component = 0;
+  std::function<double(const Vec3d& X, double t)> value;
+};
+
+class SolidModel {
+ public:
+  // block_materials[i] is the material of mesh.blocks[i]. Collective on comm.
+  SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> block_materials, ModelOptions options);
+  ~SolidModel();
+  SolidModel(const SolidModel&) = delete;
+  SolidModel& operator=(const SolidModel&) = delete;
+
+  void add_pressure(PressureLoad load);
+  void add_springs(SpringSupport springs);
+  void add_dirichlet(DirichletBC bc);
+  void set_contact(ContactModel* contact) { contact_ = contact; }
+
+  void set_time(double t) { time_ = t; }
+  double time() const { return time_; }
+  // Newton solve at the current time (collective). Never throws for non-convergence.
+  SolveReport solve();
+  void commit();    // current state becomes the committed state
+  void rollback();  // back to the last committed state
+
+  // --- access (all ranks hold the full displacement)
+  MPI_Comm comm() const { return comm_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  const Mesh& mesh() const { return mesh_; }
+  const std::vector<LayerMaterial>& materials() const { return materials_; }
+  int num_dofs() const { return 3 * int(mesh_.X.size()); }
+  int dof(int node, int comp) const { return 3 * perm_[node] + comp; }
+  int new_index(int node) const { return perm_[node]; }
+  int old_index(int new_node) const { return iperm_[new_node]; }
+  int owned_node_begin() const { return node_begin_; }  // in the new numbering
+  int owned_node_end() const { return node_end_; }
+  const std::vector<int>& local_elements() const { return local_elements_; }
+  const std::vector<int>& element_rank() const { return elem_rank_; }
+  Vec3d displacement(int node) const;
+  Vec3d position(int node) const { return mesh_.X[node] + displacement(node); }
+  void set_displacement(const std::vector<Vec3d>& u);  // by original node index (same on all ranks)
+  // Per local element (order of local_elements()): first principal Cauchy stress (Gauss-point
+  // averaged Cauchy tensor) and its unit direction.
+  void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir) const;
+  // Assemble residual (and tangent) at the current state; for tests. Returns false on invalid state.
+  bool assemble(Vec r, Mat K);
+  Mat matrix() const { return K_; }
+  Vec residual_vector() const { return r_; }
+
+ private:
+  void partition_();
+  void setup_petsc_();
+  void apply_dirichlet_values_();
+  void gather_(Vec v, std::vector<double>& full);
+
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1;
+  Mesh mesh_;
+  std::vector<LayerMaterial> materials_;
+  ModelOptions opt_;
+  std::vector<std::vector<FiberFamily>> fibers_;  // per element
+  std::vector<int> elem_rank_, node_owner_, perm_, iperm_, local_elements_;
+  int node_begin_ = 0, node_end_ = 0;
+  struct LocalFaces {
+    std::vector<Face> faces;
+  };
+  std::vector<PressureLoad> pressures_;
+  std::vector<LocalFaces> pressure_faces_;
+  std::vector<SpringSupport> springs_;
+  std::vector<LocalFaces> spring_faces_;
+  std::vector<DirichletBC> dirichlet_;
+  std::vector<PetscInt> dirichlet_rows_;  // owned global rows
+  ContactModel* contact_ = nullptr;
+  double time_ = 0.0;
+  bool apply_bc_ = true;
+  std::vector<double> u_, u_committed_;  // full copies, new numbering
+  Mat K_ = nullptr;
+  Vec r_ = nullptr, du_ = nullptr, rtrial_ = nullptr;
+  Mat Ktrial_ = nullptr;
+  KSP ksp_ = nullptr;
+  VecScatter scatter_ = nullptr;
+  Vec full_ = nullptr;
+  PetscOptions options_ = nullptr;
+};
+
+const char* petsc_default_options();
+
+}  // namespace angio::solid

@@ -1,0 +1,50 @@
+// Parallel HDF5 + XDMF field output of the solid model (one file for the whole run).
+//
+//   <dir>/solid.h5
+//     /mesh/coordinates            [N,3]  reference coordinates (solver node numbering)
+//     /mesh/original_node_id       [N]    node index in the input mesh
+//     /mesh/<type>/connectivity    [E,n]  (tet10 in VTK/XDMF edge order)
+//     /mesh/<type>/block_id        [E]    block (layer) index, see summary.json "blocks"
+//     /mesh/<type>/original_element_id [E]
+//     /steps/<k>                   attribute "time" (pseudo-time, s)
+//     /steps/<k>/displacement      [N,3]  nodal
+//     /steps/<k>/<type>/stress_p1      [E]   first principal Cauchy stress (MPa), per element:
+//                                              eigenvalue of the Gauss-point averaged Cauchy tensor
+//     /steps/<k>/<type>/stress_p1_dir  [E,3] its unit eigenvector
+//   <dir>/solid.xdmf  (rewritten after every step; open in ParaView with the Xdmf3 reader)
+#pragma once
+#include <hdf5.h>
+
+#include <string>
+#include <vector>
+
+#include "angio/solid/model.hpp"
+
+namespace angio::solid {
+
+class FieldWriter {
+ public:
+  FieldWriter(const SolidModel& model, const std::string& dir);  // collective
+  ~FieldWriter();
+  // Collective. p1/dir: per local element (model.local_elements() order), from element_stress().
+  void write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir);
+  void close();
+
+ private:
+  void write_xdmf_();
+  const SolidModel& model_;
+  std::string dir_;
+  hid_t file_ = -1;
+  struct TypeInfo {
+    ElemType type;
+    long total = 0, offset = 0;
+    std::vector<int> local;  // indices into model.local_elements()
+  };
+  std::vector<TypeInfo> types_;
+  std::vector<std::pair<int, double>> steps_;
+};
+
+// Creates a directory and its parents (like mkdir -p); throws on failure.
+void make_directories(const std::string& dir);
+
+}  // namespace angio::solid

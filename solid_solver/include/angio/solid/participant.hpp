@@ -1,0 +1,104 @@
+// The solid solver as a participant (balloon + artery), collective over an MPI communicator.
+//
+// Standalone: every rank calls the SolidParticipant methods (run_standalone on all ranks).
+// Coupled: rank 0 talks to the coupler through MpiSolidParticipant, which broadcasts every call
+// and its arguments; ranks > 0 run run_follower() and execute the same calls collectively.
+#pragma once
+#include <mpi.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "angio/participant/solid_participant.hpp"
+#include "angio/solid/output.hpp"
+#include "angio/solid/scene.hpp"
+
+namespace angio::solid {
+
+// Stent (line-to-surface) contact for the participant (a later issue): gets the beam sample points
+// before each solve, acts as the model's ContactModel during Newton, and fills the reply afterwards.
+class StentContact : public ContactModel {
+ public:
+  virtual void set_points(const participant::SamplePoints& points) = 0;
+  virtual void fill_reply(const SolidModel& model, participant::ContactReply& reply) = 0;
+};
+
+// Per committed step summary (written to <run-dir>/solid/summary.json).
+struct StepSummary {
+  int step = 0;
+  double time = 0.0;
+  std::vector<std::pair<std::string, double>> pressures;  // label, MPa
+  std::vector<double> max_p1;                              // per block (MPa)
+  double d_mid = 0.0, d_end0 = 0.0, d_end1 = 0.0;          // balloon outer diameter (mm)
+  int newton_iterations = 0;
+  double residual = 0.0;
+  double solve_seconds = 0.0;
+};
+
+class SolidRunner : public participant::SolidParticipant {
+ public:
+  // Collective. run_dir may be empty (no output). Writes the initial state as step 0.
+  SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run_dir);
+  ~SolidRunner() override;
+
+  void begin_step(int step, double time) override;
+  participant::SolveStats solve(const participant::SamplePoints& beam_points,
+                                participant::ContactReply& reply) override;
+  void end_step(bool accept) override;
+  void finish() override;
+
+  SolidModel& model() { return *model_; }
+  // Registers the stent contact (not owned; nullptr: no stent contact, zero line loads).
+  void set_stent_contact(StentContact* contact) {
+    stent_contact_ = contact;
+    model_->set_contact(contact);
+  }
+  const std::vector<StepSummary>& history() const { return history_; }
+  const SolveReport& last_report() const { return last_; }
+  // Balloon outer diameters (mm) at mid-length and both ends for the current state (all ranks).
+  void balloon_diameters(double& mid, double& end0, double& end1) const;
+
+ private:
+  void record_and_write_(int step, double time);
+  void write_summary_json_() const;
+
+  MPI_Comm comm_;
+  int rank_ = 0;
+  SolidScene scene_;
+  std::string dir_;
+  std::unique_ptr<SolidModel> model_;
+  std::unique_ptr<FieldWriter> writer_;
+  std::vector<StepSummary> history_;
+  SolveReport last_;
+  int step_ = 0;
+  int committed_ = 0;
+  double time_ = 0.0;
+  bool warned_contact_ = false;
+  StentContact* stent_contact_ = nullptr;
+  bool finished_ = false;
+  std::vector<int> ring_mid_, ring_end0_, ring_end1_;
+};
+
+// Rank-0 side of the coupled mode: broadcasts each call to the followers, then runs it.
+class MpiSolidParticipant : public participant::SolidParticipant {
+ public:
+  MpiSolidParticipant(participant::SolidParticipant& inner, MPI_Comm comm) : inner_(inner), comm_(comm) {}
+  void begin_step(int step, double time) override;
+  participant::SolveStats solve(const participant::SamplePoints& beam_points,
+                                participant::ContactReply& reply) override;
+  void end_step(bool accept) override;
+  void finish() override;
+  // Releases the followers if finish() was never called (e.g. the coupler vanished).
+  void shutdown();
+
+ private:
+  participant::SolidParticipant& inner_;
+  MPI_Comm comm_;
+  bool finished_ = false;
+};
+
+// Ranks > 0 in the coupled mode: executes broadcast calls until finish. Returns 0.
+int run_follower(participant::SolidParticipant& inner, MPI_Comm comm);
+
+}  // namespace angio::solid

@@ -1,0 +1,53 @@
+// Reading the solid parts of a scene (balloon:, artery:, solid:) into a mesh, materials, loads
+// and solver options. See solid_solver/README.md for the keys.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "angio/scene/load_curve.hpp"
+#include "angio/scene/node.hpp"
+#include "angio/solid/model.hpp"
+
+namespace angio::solid {
+
+struct PressureSpec {
+  std::string surface;
+  double value = 0.0;       // MPa, multiplied by the curve
+  scene::LoadCurve curve;   // constant 1 when the scene gives none
+  std::string label;        // "balloon_pressure" / "blood_pressure"
+};
+struct SpringSpec {
+  std::string surface;
+  double stiffness = 0.0;   // N/mm^3
+};
+// Balloon outer diameter stations for the summary (mid-length and both ends).
+// Zero displacement of the given components on the nodes of a surface set.
+struct FixedSpec {
+  std::string surface;
+  std::vector<int> components;
+};
+struct DiameterSpec {
+  std::string node_set;     // outer surface nodes
+  Axis axis;
+  double s_mid = 0.0, s_end0 = 0.0, s_end1 = 0.0;  // axial coordinates along the axis
+};
+
+struct SolidScene {
+  Mesh mesh;
+  std::vector<LayerMaterial> materials;  // per mesh block
+  ModelOptions options;
+  std::vector<PressureSpec> pressures;
+  std::vector<SpringSpec> springs;
+  std::vector<FixedSpec> fixed;
+  std::optional<DiameterSpec> balloon_diameter;
+  bool has_balloon = false, has_artery = false;
+  int ranks = 0;  // solid.ranks (0: not given)
+  int output_every = 1;
+  scene::TimeSettings time;
+};
+
+// Throws scene::SceneError ("file: key.path: expected ...") on invalid input.
+SolidScene read_solid_scene(const scene::Node& root);
+
+}  // namespace angio::solid

@@ -1,0 +1,136 @@
+// Contact in the solid solver (issue "Contact"): the contact kernels of solid_solver/contact wired into
+// SolidModel's ContactModel hook.
+//
+//  * PenaltyStentContact: stent (beam sample points, DESIGN.md §2) against the balloon outer surface and/or
+//    the artery endothelium, line-to-surface penalty (paper §2.5). A point may touch both surfaces; the line
+//    loads add up. The beam points are held fixed during the solid's Newton solve (Dirichlet–Neumann).
+//  * PenaltySurfaceContact: balloon outer surface (slave) against the artery endothelium (master),
+//    Gauss-point-to-segment penalty (the paper uses mortar).
+//  * CompositeContact: the StentContact registered with SolidRunner (SolidModel holds one ContactModel
+//    pointer); forwards add() to both and the reply to the stent part.
+//
+// MPI: every rank holds the full displacement, so the searches are built over the whole surfaces on rank 0;
+// rank 0 evaluates and adds the residual/tangent (ADD_VALUES, communicated by the model's assembly), the other
+// ranks add nothing, so every contribution enters the global system exactly once. add() is collective (it
+// broadcasts the diagnostics); fill_reply() evaluates on every rank (identical data, no communication).
+// Units: mm, N, MPa.
+#pragma once
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "angio/contact/contact.hpp"
+#include "angio/solid/participant.hpp"
+
+namespace angio::solid {
+
+// contact::Surface from a mesh surface set (faces oriented out of their volume: normal_sign = +1 makes the
+// contact normal point out of the body, i.e. toward the stent / into the lumen).
+contact::Surface to_contact_surface(const SurfaceSet& s, double normal_sign = 1.0);
+
+// Summary of one contact evaluation (same on every rank after add()).
+struct ContactSummary {
+  int num_points = 0;     // (point or Gauss point, surface) pairs with a closest point in range
+  int num_active = 0;     // pairs with g < 0
+  double min_gap = 0.0;   // smallest gap (mm); +search radius if nothing was in range
+  double force = 0.0;     // |net force| on the solid (line contact: on balloon+artery; surface: on the master), N
+  double force_magnitude = 0.0;  // sum over pairs of |force| (N)
+  double energy = 0.0;    // penalty potential (N mm)
+};
+
+// Wall time spent in add() (search update + evaluation + insertion into r/K), rank 0.
+struct ContactTiming {
+  long calls = 0;
+  double seconds = 0.0;
+  void reset() { *this = {}; }
+};
+
+class PenaltyStentContact : public StentContact {
+ public:
+  struct Options {
+    std::optional<double> balloon_penalty;  // N/mm^2; unset: no stent-balloon contact
+    std::optional<double> artery_penalty;   // N/mm^2; unset: no stent-artery contact
+    double search_radius = 0.3;             // mm; must exceed R + the largest penetration
+    std::string balloon_surface = "balloon_outer";
+    std::string artery_surface = "artery_inner";
+  };
+  // Surfaces that the mesh does not have are skipped (e.g. no artery in a free expansion scene).
+  PenaltyStentContact(const SolidModel& model, Options opt);
+  ~PenaltyStentContact() override;
+
+  void set_points(const participant::SamplePoints& points) override;
+  void add(const SolidModel& model, Vec r, Mat K) override;
+  void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
+
+  int num_surfaces() const { return int(surfaces_.size()); }
+  const std::vector<std::string>& surface_names() const { return names_; }
+  const ContactSummary& last() const { return last_; }  // of the last add()
+  ContactTiming& timing() { return timing_; }
+  std::size_t num_points() const { return points_.size(); }
+
+ private:
+  struct Eval;
+  void evaluate_(const SolidModel& model, bool tangent, Eval& out);
+
+  Options opt_;
+  std::vector<std::string> names_;
+  std::vector<double> penalty_;
+  std::vector<std::unique_ptr<contact::Surface>> surfaces_;
+  std::vector<std::unique_ptr<contact::SurfaceSearch>> searches_;
+  std::vector<contact::BeamPoint> points_;
+  std::vector<contact::Vec3> coords_;
+  ContactSummary last_;
+  ContactTiming timing_;
+};
+
+class PenaltySurfaceContact : public ContactModel {
+ public:
+  struct Options {
+    double penalty = 5.0;      // N/mm^3 (pressure per penetration)
+    int quadrature = 3;        // slave face rule degree (3: quad 2x2)
+    bool two_pass = false;
+    double search_radius = 0.3;
+    std::string slave = "balloon_outer";
+    std::string master = "artery_inner";
+  };
+  // Throws std::runtime_error if a surface set is missing.
+  PenaltySurfaceContact(const SolidModel& model, Options opt);
+  ~PenaltySurfaceContact() override;
+  void add(const SolidModel& model, Vec r, Mat K) override;
+
+  const ContactSummary& last() const { return last_; }
+  double active_area() const { return active_area_; }
+  ContactTiming& timing() { return timing_; }
+
+ private:
+  Options opt_;
+  std::unique_ptr<contact::Surface> slave_, master_;
+  std::unique_ptr<contact::SurfaceSearch> ss_, sm_;
+  std::vector<contact::Vec3> coords_;
+  ContactSummary last_;
+  double active_area_ = 0.0;
+  ContactTiming timing_;
+};
+
+// The one contact registered with the runner: stent line contact (optional) + any other contact models.
+class CompositeContact : public StentContact {
+ public:
+  void set_stent(PenaltyStentContact* s) { stent_ = s; }
+  void add_model(ContactModel* m) { others_.push_back(m); }
+  void set_points(const participant::SamplePoints& points) override;
+  void add(const SolidModel& model, Vec r, Mat K) override;
+  void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
+  // Called on every rank after each converged solve's reply (e.g. logging of the contact diagnostics).
+  std::function<void(const SolidModel&, const participant::ContactReply&)> after_reply;
+
+ private:
+  PenaltyStentContact* stent_ = nullptr;
+  std::vector<ContactModel*> others_;
+};
+
+// Helpers shared with the tests: fill a contact-free reply (as SolidRunner::solve does).
+void reset_reply(const participant::SamplePoints& points, participant::ContactReply& reply);
+
+}  // namespace angio::solid

@@ -1,0 +1,349 @@
+#include "angio/solid/elements.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace angio::solid {
+
+int num_nodes(ElemType t) {
+  switch (t) {
+    case ElemType::Hex8: return 8;
+    case ElemType::Tet4: return 4;
+    case ElemType::Tet10: return 10;
+  }
+  return 0;
+}
+int num_nodes(FaceType t) {
+  switch (t) {
+    case FaceType::Quad4: return 4;
+    case FaceType::Tri3: return 3;
+    case FaceType::Tri6: return 6;
+  }
+  return 0;
+}
+int num_corners(FaceType t) { return t == FaceType::Quad4 ? 4 : 3; }
+const char* name(ElemType t) {
+  switch (t) {
+    case ElemType::Hex8: return "hex8";
+    case ElemType::Tet4: return "tet4";
+    case ElemType::Tet10: return "tet10";
+  }
+  return "?";
+}
+const char* name(FaceType t) {
+  switch (t) {
+    case FaceType::Quad4: return "quad4";
+    case FaceType::Tri3: return "tri3";
+    case FaceType::Tri6: return "tri6";
+  }
+  return "?";
+}
+
+const std::vector<QuadPoint>& volume_rule(ElemType t) {
+  static const std::vector<QuadPoint> hex = [] {
+    std::vector<QuadPoint> r;
+    const double g = 1.0 / std::sqrt(3.0);
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) r.push_back({{i ? g : -g, j ? g : -g, k ? g : -g}, 1.0});
+    return r;
+  }();
+  static const std::vector<QuadPoint> tet1 = {{{0.25, 0.25, 0.25}, 1.0 / 6.0}};
+  static const std::vector<QuadPoint> tet4 = [] {
+    const double a = 0.5854101966249685, b = 0.1381966011250105;
+    return std::vector<QuadPoint>{{{b, b, b}, 1.0 / 24.0}, {{a, b, b}, 1.0 / 24.0}, {{b, a, b}, 1.0 / 24.0},
+                                  {{b, b, a}, 1.0 / 24.0}};
+  }();
+  switch (t) {
+    case ElemType::Hex8: return hex;
+    case ElemType::Tet4: return tet1;
+    case ElemType::Tet10: return tet4;
+  }
+  throw std::logic_error("volume_rule");
+}
+
+const std::vector<QuadPoint>& face_rule(FaceType t) {
+  static const std::vector<QuadPoint> quad = [] {
+    std::vector<QuadPoint> r;
+    const double g = 1.0 / std::sqrt(3.0);
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) r.push_back({{i ? g : -g, j ? g : -g, 0.0}, 1.0});
+    return r;
+  }();
+  static const std::vector<QuadPoint> tri3 = {{{1.0 / 6, 1.0 / 6, 0}, 1.0 / 6},
+                                              {{2.0 / 3, 1.0 / 6, 0}, 1.0 / 6},
+                                              {{1.0 / 6, 2.0 / 3, 0}, 1.0 / 6}};
+  static const std::vector<QuadPoint> tri6 = [] {
+    const double a1 = 0.445948490915965, b1 = 0.108103018168070, w1 = 0.223381589678011 / 2;
+    const double a2 = 0.091576213509771, b2 = 0.816847572980459, w2 = 0.109951743655322 / 2;
+    return std::vector<QuadPoint>{{{a1, a1, 0}, w1}, {{b1, a1, 0}, w1}, {{a1, b1, 0}, w1},
+                                  {{a2, a2, 0}, w2}, {{b2, a2, 0}, w2}, {{a2, b2, 0}, w2}};
+  }();
+  switch (t) {
+    case FaceType::Quad4: return quad;
+    case FaceType::Tri3: return tri3;
+    case FaceType::Tri6: return tri6;
+  }
+  throw std::logic_error("face_rule");
+}
+
+void shape(ElemType t, const double* xi, Eigen::VectorXd& N, Eigen::MatrixXd& dN) {
+  const int n = num_nodes(t);
+  N.resize(n);
+  dN.resize(n, 3);
+  if (t == ElemType::Hex8) {
+    static const int s[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+    for (int a = 0; a < 8; ++a) {
+      const double fx = 1 + s[a][0] * xi[0], fy = 1 + s[a][1] * xi[1], fz = 1 + s[a][2] * xi[2];
+      N(a) = 0.125 * fx * fy * fz;
+      dN(a, 0) = 0.125 * s[a][0] * fy * fz;
+      dN(a, 1) = 0.125 * fx * s[a][1] * fz;
+      dN(a, 2) = 0.125 * fx * fy * s[a][2];
+    }
+    return;
+  }
+  const double L[4] = {1 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]};
+  // dL_i/dxi_j
+  static const double dL[4][3] = {{-1, -1, -1}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  if (t == ElemType::Tet4) {
+    for (int a = 0; a < 4; ++a) {
+      N(a) = L[a];
+      for (int j = 0; j < 3; ++j) dN(a, j) = dL[a][j];
+    }
+    return;
+  }
+  // Tet10 (gmsh): vertices, then edges 01 12 20 30 32 31
+  static const int e[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
+  for (int a = 0; a < 4; ++a) {
+    N(a) = L[a] * (2 * L[a] - 1);
+    for (int j = 0; j < 3; ++j) dN(a, j) = (4 * L[a] - 1) * dL[a][j];
+  }
+  for (int m = 0; m < 6; ++m) {
+    const int p = e[m][0], q = e[m][1];
+    N(4 + m) = 4 * L[p] * L[q];
+    for (int j = 0; j < 3; ++j) dN(4 + m, j) = 4 * (dL[p][j] * L[q] + L[p] * dL[q][j]);
+  }
+}
+
+void shape(FaceType t, const double* xi, Eigen::VectorXd& N, Eigen::MatrixXd& dN) {
+  const int n = num_nodes(t);
+  N.resize(n);
+  dN.resize(n, 2);
+  if (t == FaceType::Quad4) {
+    static const int s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (int a = 0; a < 4; ++a) {
+      N(a) = 0.25 * (1 + s[a][0] * xi[0]) * (1 + s[a][1] * xi[1]);
+      dN(a, 0) = 0.25 * s[a][0] * (1 + s[a][1] * xi[1]);
+      dN(a, 1) = 0.25 * (1 + s[a][0] * xi[0]) * s[a][1];
+    }
+    return;
+  }
+  const double L[3] = {1 - xi[0] - xi[1], xi[0], xi[1]};
+  static const double dL[3][2] = {{-1, -1}, {1, 0}, {0, 1}};
+  if (t == FaceType::Tri3) {
+    for (int a = 0; a < 3; ++a) {
+      N(a) = L[a];
+      dN(a, 0) = dL[a][0];
+      dN(a, 1) = dL[a][1];
+    }
+    return;
+  }
+  static const int e[3][2] = {{0, 1}, {1, 2}, {2, 0}};
+  for (int a = 0; a < 3; ++a) {
+    N(a) = L[a] * (2 * L[a] - 1);
+    for (int j = 0; j < 2; ++j) dN(a, j) = (4 * L[a] - 1) * dL[a][j];
+  }
+  for (int m = 0; m < 3; ++m) {
+    const int p = e[m][0], q = e[m][1];
+    N(3 + m) = 4 * L[p] * L[q];
+    for (int j = 0; j < 2; ++j) dN(3 + m, j) = 4 * (dL[p][j] * L[q] + L[p] * dL[q][j]);
+  }
+}
+
+std::vector<Vec3d> reference_nodes(ElemType t) {
+  switch (t) {
+    case ElemType::Hex8:
+      return {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+    case ElemType::Tet4: return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    case ElemType::Tet10:
+      return {{0, 0, 0},     {1, 0, 0},     {0, 1, 0},   {0, 0, 1},     {0.5, 0, 0},
+              {0.5, 0.5, 0}, {0, 0.5, 0},   {0, 0, 0.5}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
+  }
+  return {};
+}
+
+const std::vector<LocalFace>& local_faces(ElemType t) {
+  static const std::vector<LocalFace> hex = {{FaceType::Quad4, {0, 3, 2, 1}}, {FaceType::Quad4, {4, 5, 6, 7}},
+                                             {FaceType::Quad4, {0, 1, 5, 4}}, {FaceType::Quad4, {1, 2, 6, 5}},
+                                             {FaceType::Quad4, {2, 3, 7, 6}}, {FaceType::Quad4, {0, 4, 7, 3}}};
+  static const std::vector<LocalFace> tet4 = {{FaceType::Tri3, {0, 2, 1}},
+                                              {FaceType::Tri3, {0, 1, 3}},
+                                              {FaceType::Tri3, {1, 2, 3}},
+                                              {FaceType::Tri3, {0, 3, 2}}};
+  // tet10 edges: 4:01 5:12 6:20 7:30 8:32 9:31
+  static const std::vector<LocalFace> tet10 = {{FaceType::Tri6, {0, 2, 1, 6, 5, 4}},
+                                               {FaceType::Tri6, {0, 1, 3, 4, 9, 7}},
+                                               {FaceType::Tri6, {1, 2, 3, 5, 8, 9}},
+                                               {FaceType::Tri6, {0, 3, 2, 7, 8, 6}}};
+  switch (t) {
+    case ElemType::Hex8: return hex;
+    case ElemType::Tet4: return tet4;
+    case ElemType::Tet10: return tet10;
+  }
+  throw std::logic_error("local_faces");
+}
+
+namespace {
+// Fixed-size implementation (NN nodes) of element_internal; dN/dxi at the Gauss points is cached.
+template <int NN>
+bool element_internal_fixed(ElemType t, const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud, const NeoHooke& mat,
+                            const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
+                            ElementStress* out) {
+  using MatN3 = Eigen::Matrix<double, NN, 3>;
+  using VecF = Eigen::Matrix<double, 3 * NN, 1>;
+  using MatK = Eigen::Matrix<double, 3 * NN, 3 * NN>;
+  using MatB = Eigen::Matrix<double, 6, 3 * NN>;
+  const auto& rule = volume_rule(t);
+  static const std::vector<MatN3> dNq = [&] {
+    std::vector<MatN3> v;
+    Eigen::VectorXd N;
+    Eigen::MatrixXd dN;
+    for (const auto& qp : volume_rule(t)) {
+      shape(t, qp.xi, N, dN);
+      v.push_back(dN);
+    }
+    return v;
+  }();
+  const MatN3 X = Xd, u = ud;
+  VecF fe = VecF::Zero();
+  MatK Ke;
+  if (K) Ke.setZero();
+  if (out) *out = ElementStress{};
+  MatB B;
+  Mat3 S;
+  Mat6 D;
+  bool ok = true;
+  for (size_t q = 0; q < rule.size(); ++q) {
+    const MatN3& dN = dNq[q];
+    const Mat3 J0 = X.transpose() * dN;
+    const double detJ0 = J0.determinant();
+    if (!(detJ0 > 0.0)) {
+      ok = false;
+      continue;
+    }
+    const MatN3 G = dN * J0.inverse();
+    const Mat3 F = Mat3::Identity() + u.transpose() * G;
+    const double detF = F.determinant();
+    if (!(detF > 0.0)) ok = false;
+    const Mat3 C = F.transpose() * F;
+    stress_tangent(mat, fibers, C, S, K ? &D : nullptr);
+    const double dV = detJ0 * rule[q].w;
+    for (int a = 0; a < NN; ++a)
+      for (int i = 0; i < 3; ++i) {
+        B(0, 3 * a + i) = F(i, 0) * G(a, 0);
+        B(1, 3 * a + i) = F(i, 1) * G(a, 1);
+        B(2, 3 * a + i) = F(i, 2) * G(a, 2);
+        B(3, 3 * a + i) = F(i, 0) * G(a, 1) + F(i, 1) * G(a, 0);
+        B(4, 3 * a + i) = F(i, 1) * G(a, 2) + F(i, 2) * G(a, 1);
+        B(5, 3 * a + i) = F(i, 0) * G(a, 2) + F(i, 2) * G(a, 0);
+      }
+    const Vec6 sv = to_voigt_stress(S);
+    fe.noalias() += B.transpose() * (sv * dV);
+    if (K) {
+      const Eigen::Matrix<double, 6, 3 * NN> DB = (D * dV) * B;
+      Ke.noalias() += B.transpose() * DB;
+      const Eigen::Matrix<double, NN, NN> GSG = G * (S * dV) * G.transpose();
+      for (int a = 0; a < NN; ++a)
+        for (int b = 0; b < NN; ++b)
+          for (int i = 0; i < 3; ++i) Ke(3 * a + i, 3 * b + i) += GSG(a, b);
+    }
+    if (out) {
+      out->cauchy_avg += F * S * F.transpose() / detF;
+      out->energy += energy(mat, fibers, C) * dV;
+      out->volume += dV;
+    }
+  }
+  if (out) out->cauchy_avg /= double(rule.size());
+  f = fe;
+  if (K) *K = Ke;
+  return ok && f.allFinite();
+}
+}  // namespace
+
+bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixXd& u, const NeoHooke& mat,
+                      const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
+                      ElementStress* out) {
+  switch (t) {
+    case ElemType::Hex8: return element_internal_fixed<8>(t, X, u, mat, fibers, f, K, out);
+    case ElemType::Tet4: return element_internal_fixed<4>(t, X, u, mat, fibers, f, K, out);
+    case ElemType::Tet10: return element_internal_fixed<10>(t, X, u, mat, fibers, f, K, out);
+  }
+  return false;
+}
+
+static Mat3 skew(const Vec3d& a) {
+  Mat3 m;
+  m << 0, -a(2), a(1), a(2), 0, -a(0), -a(1), a(0), 0;
+  return m;
+}
+
+void face_pressure(FaceType t, const Eigen::MatrixXd& x, double p, Eigen::VectorXd& r, Eigen::MatrixXd* K) {
+  const int n = num_nodes(t);
+  r.setZero(3 * n);
+  if (K) K->setZero(3 * n, 3 * n);
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  for (const auto& qp : face_rule(t)) {
+    shape(t, qp.xi, N, dN);
+    const Vec3d g1 = x.transpose() * dN.col(0);
+    const Vec3d g2 = x.transpose() * dN.col(1);
+    const Vec3d an = g1.cross(g2);
+    for (int a = 0; a < n; ++a) r.segment<3>(3 * a) += p * qp.w * N(a) * an;
+    if (K) {
+      // d(g1 x g2)/dx_b = dN_b,xi (-skew(g2)) + dN_b,eta skew(g1)
+      const Mat3 s1 = skew(g1), s2 = skew(g2);
+      for (int b = 0; b < n; ++b) {
+        const Mat3 dAn = dN(b, 1) * s1 - dN(b, 0) * s2;
+        for (int a = 0; a < n; ++a) K->block<3, 3>(3 * a, 3 * b) += p * qp.w * N(a) * dAn;
+      }
+    }
+  }
+}
+
+void face_springs(FaceType t, const Eigen::MatrixXd& X, const Eigen::MatrixXd& u, double k, Eigen::VectorXd& r,
+                  Eigen::MatrixXd* K) {
+  const int n = num_nodes(t);
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  for (const auto& qp : face_rule(t)) {
+    shape(t, qp.xi, N, dN);
+    const Vec3d g1 = X.transpose() * dN.col(0);
+    const Vec3d g2 = X.transpose() * dN.col(1);
+    M += (k * qp.w * g1.cross(g2).norm()) * N * N.transpose();
+  }
+  r.setZero(3 * n);
+  if (K) K->setZero(3 * n, 3 * n);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) {
+      r.segment<3>(3 * a) += M(a, b) * u.row(b).transpose();
+      if (K)
+        for (int i = 0; i < 3; ++i) (*K)(3 * a + i, 3 * b + i) += M(a, b);
+    }
+}
+
+Vec3d face_area_vector(FaceType t, const Eigen::MatrixXd& X) {
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  Vec3d A = Vec3d::Zero();
+  for (const auto& qp : face_rule(t)) {
+    shape(t, qp.xi, N, dN);
+    const Vec3d g1 = X.transpose() * dN.col(0);
+    const Vec3d g2 = X.transpose() * dN.col(1);
+    A += qp.w * g1.cross(g2);
+  }
+  return A;
+}
+
+}  // namespace angio::solid

@@ -1,0 +1,91 @@
+// solid_solver: balloon and artery as 3D nonlinear solids (MPI + PETSc + HDF5).
+//
+//   mpirun -n 2 solid_solver --scene configs/solid_free_balloon.yaml --run-dir runs/balloon
+//       standalone load stepping (no coupler; every rank runs the stepping loop collectively)
+//   mpirun -n 2 solid_solver --scene S --run-dir D --endpoint E --run-id ID
+//       coupled: rank 0 serves the solid role to the coupler, ranks > 0 follow over MPI
+// Exit codes: 0 success, 2 bad input (scene/mesh), 3 a step could not be completed,
+// 4/5 coupler gone / transport failure (coupled mode), 1 internal error.
+#include <mpi.h>
+#include <petscsys.h>
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "angio/common/cli.hpp"
+#include "angio/common/log.hpp"
+#include "angio/participant/standalone.hpp"
+#include "angio/solid/participant.hpp"
+#include "angio/solid/scene.hpp"
+#ifdef ANGIO_SOLID_HAVE_SERVE
+#include "angio/participant/role_server.hpp"
+#endif
+
+int main(int argc, char** argv) {
+  // PETSc must not see our command line (it would complain about unknown options).
+  int fake_argc = 1;
+  char** fake_argv = argv;
+  if (PetscInitialize(&fake_argc, &fake_argv, nullptr, nullptr)) return 1;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  int code = 0;
+  {
+    angio::cli::Parser cli("solid_solver",
+                           "Balloon and artery (3D nonlinear solids, MPI + PETSc). Standalone load stepping, or "
+                           "the solid role of a coupled run when --endpoint is given.");
+    cli.add_common();
+    try {
+      if (!cli.parse(argc, argv)) {
+        PetscFinalize();
+        return 0;
+      }
+      angio::cli::setup_logging(cli, "solid");
+      if (rank != 0) angio::log::set_level(angio::log::Level::error);
+    } catch (const std::exception& e) {
+      if (rank == 0) std::cerr << "solid_solver: " << e.what() << "\n" << cli.usage();
+      PetscFinalize();
+      return 2;
+    }
+    angio::solid::SolidScene scene;
+    angio::scene::TimeSettings time_settings;
+    try {
+      const auto root = angio::scene::load_scene(cli.get("scene"));
+      scene = angio::solid::read_solid_scene(root);
+      time_settings = scene.time;
+    } catch (const std::exception& e) {
+      if (rank == 0) LOG_ERROR(e.what());
+      PetscFinalize();
+      return 2;
+    }
+    try {
+      angio::solid::SolidRunner runner(PETSC_COMM_WORLD, std::move(scene), cli.get("run-dir"));
+      const std::string endpoint = cli.maybe("endpoint").value_or("");
+      if (endpoint.empty()) {
+        code = angio::participant::run_standalone(runner, time_settings);
+      } else {
+#ifdef ANGIO_SOLID_HAVE_SERVE
+        if (rank == 0) {
+          angio::solid::MpiSolidParticipant leader(runner, PETSC_COMM_WORLD);
+          const auto so = angio::participant::serve_options(cli, "angio solid_solver");
+          code = angio::participant::serve(leader, so);
+          leader.shutdown();
+        } else {
+          code = angio::solid::run_follower(runner, PETSC_COMM_WORLD);
+        }
+        MPI_Bcast(&code, 1, MPI_INT, 0, PETSC_COMM_WORLD);
+#else
+        if (rank == 0) LOG_ERROR("this build has no zenoh transport; run without --endpoint");
+        code = 2;
+#endif
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "solid_solver (rank %d): fatal: %s\n", rank, e.what());
+      std::fflush(stderr);
+      MPI_Abort(PETSC_COMM_WORLD, 1);
+    }
+  }
+  PetscFinalize();
+  return code;
+}

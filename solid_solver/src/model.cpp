@@ -1,0 +1,534 @@
+#include "angio/solid/model.hpp"
+
+#include <petscmat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace angio::solid {
+
+#define ANGIO_PETSC(call)                                                                     \
+  do {                                                                                      \
+    PetscErrorCode ierr_ = (call);                                                          \
+    if (ierr_) throw std::runtime_error(std::string("PETSc error in ") + #call + " (code " + \
+                                        std::to_string(int(ierr_)) + ")");                  \
+  } while (0)
+
+const char* petsc_default_options() {
+  return "-ksp_type gmres -ksp_gmres_restart 200 -ksp_rtol 1e-6 -ksp_atol 1e-14 -ksp_max_it 1000 "
+         "-pc_type bjacobi -sub_pc_type ilu -sub_pc_factor_levels 1";
+}
+
+namespace {
+// RAII push of the model's private options database (so several models in one process, e.g. in
+// tests, do not see each other's options).
+struct OptionsScope {
+  explicit OptionsScope(PetscOptions o) : o_(o) { PetscOptionsPush(o_); }
+  ~OptionsScope() { PetscOptionsPop(); }
+  PetscOptions o_;
+};
+}  // namespace
+
+SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats, ModelOptions options)
+    : comm_(comm), mesh_(std::move(mesh)), materials_(std::move(mats)), opt_(std::move(options)) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+  if (materials_.size() != mesh_.blocks.size())
+    throw std::runtime_error("solid model: " + std::to_string(mesh_.blocks.size()) + " blocks but " +
+                             std::to_string(materials_.size()) + " materials");
+  fibers_.resize(mesh_.elements.size());
+  for (size_t e = 0; e < mesh_.elements.size(); ++e) {
+    const auto& mat = materials_[mesh_.elements[e].block];
+    if (!mat.fibers.empty())
+      fibers_[e] = resolve_fibers(mat, mesh_.frames.size() == mesh_.elements.size()
+                                           ? mesh_.frames[e]
+                                           : element_frame(mesh_, int(e), opt_.axis));
+  }
+  // reference Jacobians must be positive (catches inverted elements of imported meshes early)
+  {
+    Eigen::VectorXd N;
+    Eigen::MatrixXd dN, X;
+    for (size_t e = 0; e < mesh_.elements.size(); ++e) {
+      const auto& el = mesh_.elements[e];
+      X.resize(el.nn(), 3);
+      for (int a = 0; a < el.nn(); ++a) X.row(a) = mesh_.X[el.n[a]].transpose();
+      for (const auto& qp : volume_rule(el.type)) {
+        shape(el.type, qp.xi, N, dN);
+        if (!((X.transpose() * dN).determinant() > 0.0))
+          throw std::runtime_error("solid mesh: element " + std::to_string(e) + " (" + name(el.type) + ", block '" +
+                                   mesh_.blocks[el.block].name +
+                                   "') has a non-positive reference Jacobian (inverted or degenerate)");
+      }
+    }
+  }
+  partition_();
+  setup_petsc_();
+  u_.assign(3 * mesh_.X.size(), 0.0);
+  u_committed_ = u_;
+}
+
+SolidModel::~SolidModel() {
+  if (ksp_) KSPDestroy(&ksp_);
+  if (K_) MatDestroy(&K_);
+  if (r_) VecDestroy(&r_);
+  if (du_) VecDestroy(&du_);
+  if (full_) VecDestroy(&full_);
+  if (scatter_) VecScatterDestroy(&scatter_);
+  if (options_) PetscOptionsDestroy(&options_);
+}
+
+void SolidModel::partition_() {
+  const int ne = int(mesh_.elements.size()), nn = int(mesh_.X.size());
+  elem_rank_.assign(ne, 0);
+  if (size_ > 1 && opt_.partitioner != "contiguous") {
+    // element dual graph (shared faces)
+    std::unordered_map<long long, int> first;
+    std::vector<std::vector<int>> adj(ne);
+    for (int e = 0; e < ne; ++e) {
+      const auto& el = mesh_.elements[e];
+      for (const auto& lf : local_faces(el.type)) {
+        std::array<int, 4> c{};
+        const int nc = num_corners(lf.type);
+        for (int a = 0; a < nc; ++a) c[a] = el.n[lf.nodes[a]];
+        for (int a = 1; a < nc; ++a)
+          for (int b = a; b > 0 && c[b - 1] > c[b]; --b) std::swap(c[b - 1], c[b]);
+        const long long key = (long long)c[0] * 1000003LL * 1000003LL + (long long)c[1] * 1000003LL + c[2];
+        auto [it, fresh] = first.emplace(key, e);
+        if (!fresh) {
+          adj[e].push_back(it->second);
+          adj[it->second].push_back(e);
+        }
+      }
+    }
+    const int e0 = int((long long)ne * rank_ / size_), e1 = int((long long)ne * (rank_ + 1) / size_);
+    PetscInt *ia, *ja;
+    PetscInt nnz = 0;
+    for (int e = e0; e < e1; ++e) nnz += PetscInt(adj[e].size());
+    ANGIO_PETSC(PetscMalloc1(e1 - e0 + 1, &ia));
+    ANGIO_PETSC(PetscMalloc1(std::max<PetscInt>(nnz, 1), &ja));
+    ia[0] = 0;
+    for (int e = e0; e < e1; ++e) {
+      std::sort(adj[e].begin(), adj[e].end());
+      ia[e - e0 + 1] = ia[e - e0] + PetscInt(adj[e].size());
+      std::copy(adj[e].begin(), adj[e].end(), ja + ia[e - e0]);
+    }
+    Mat A;
+    ANGIO_PETSC(MatCreateMPIAdj(comm_, e1 - e0, ne, ia, ja, nullptr, &A));
+    MatPartitioning part;
+    ANGIO_PETSC(MatPartitioningCreate(comm_, &part));
+    ANGIO_PETSC(MatPartitioningSetAdjacency(part, A));
+    ANGIO_PETSC(MatPartitioningSetType(part, opt_.partitioner.c_str()));
+    IS is, isall;
+    ANGIO_PETSC(MatPartitioningApply(part, &is));
+    ANGIO_PETSC(ISAllGather(is, &isall));
+    const PetscInt* idx;
+    ANGIO_PETSC(ISGetIndices(isall, &idx));
+    for (int e = 0; e < ne; ++e) elem_rank_[e] = int(idx[e]);
+    ANGIO_PETSC(ISRestoreIndices(isall, &idx));
+    ISDestroy(&is);
+    ISDestroy(&isall);
+    MatPartitioningDestroy(&part);
+    MatDestroy(&A);
+  } else {
+    for (int e = 0; e < ne; ++e) elem_rank_[e] = int((long long)e * size_ / std::max(ne, 1));
+  }
+  node_owner_.assign(nn, size_);
+  for (int e = 0; e < ne; ++e) {
+    const auto& el = mesh_.elements[e];
+    for (int a = 0; a < el.nn(); ++a) node_owner_[el.n[a]] = std::min(node_owner_[el.n[a]], elem_rank_[e]);
+  }
+  for (auto& o : node_owner_)
+    if (o == size_) o = 0;  // unreferenced node
+  perm_.assign(nn, 0);
+  iperm_.assign(nn, 0);
+  std::vector<int> count(size_ + 1, 0);
+  for (int o : node_owner_) ++count[o + 1];
+  for (int r = 0; r < size_; ++r) count[r + 1] += count[r];
+  node_begin_ = count[rank_];
+  node_end_ = count[rank_ + 1];
+  std::vector<int> next(count.begin(), count.end() - 1);
+  for (int i = 0; i < nn; ++i) {
+    perm_[i] = next[node_owner_[i]]++;
+    iperm_[perm_[i]] = i;
+  }
+  local_elements_.clear();
+  for (int e = 0; e < ne; ++e)
+    if (elem_rank_[e] == rank_) local_elements_.push_back(e);
+}
+
+void SolidModel::setup_petsc_() {
+  const int nn = int(mesh_.X.size()), nloc = node_end_ - node_begin_;
+  // node adjacency of owned nodes -> block preallocation
+  std::vector<std::vector<int>> nbr(nloc);
+  for (const auto& el : mesh_.elements) {
+    for (int a = 0; a < el.nn(); ++a) {
+      const int pa = perm_[el.n[a]];
+      if (pa < node_begin_ || pa >= node_end_) continue;
+      auto& v = nbr[pa - node_begin_];
+      for (int b = 0; b < el.nn(); ++b) v.push_back(perm_[el.n[b]]);
+    }
+  }
+  std::vector<PetscInt> dnnz(nloc), onnz(nloc);
+  for (int i = 0; i < nloc; ++i) {
+    auto& v = nbr[i];
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    if (v.empty()) v.push_back(node_begin_ + i);
+    int d = 0;
+    for (int j : v) d += (j >= node_begin_ && j < node_end_);
+    dnnz[i] = d;
+    onnz[i] = PetscInt(v.size()) - d;
+  }
+  ANGIO_PETSC(MatCreate(comm_, &K_));
+  ANGIO_PETSC(MatSetSizes(K_, 3 * nloc, 3 * nloc, 3 * nn, 3 * nn));
+  ANGIO_PETSC(MatSetType(K_, MATAIJ));
+  ANGIO_PETSC(MatSetBlockSize(K_, 3));
+  ANGIO_PETSC(MatXAIJSetPreallocation(K_, 3, dnnz.data(), onnz.data(), nullptr, nullptr));
+  ANGIO_PETSC(MatSetOption(K_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));  // contact may add entries
+  ANGIO_PETSC(MatSetOption(K_, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
+  ANGIO_PETSC(MatSetOption(K_, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
+  ANGIO_PETSC(MatCreateVecs(K_, &du_, &r_));
+  ANGIO_PETSC(VecSetBlockSize(du_, 3));
+  // rigid-body near null space (for GAMG; harmless otherwise)
+  {
+    Vec coords;
+    ANGIO_PETSC(VecDuplicate(du_, &coords));
+    ANGIO_PETSC(VecSetBlockSize(coords, 3));
+    PetscScalar* c;
+    ANGIO_PETSC(VecGetArray(coords, &c));
+    for (int i = node_begin_; i < node_end_; ++i)
+      for (int k = 0; k < 3; ++k) c[3 * (i - node_begin_) + k] = mesh_.X[iperm_[i]](k);
+    ANGIO_PETSC(VecRestoreArray(coords, &c));
+    MatNullSpace nsp;
+    ANGIO_PETSC(MatNullSpaceCreateRigidBody(coords, &nsp));
+    ANGIO_PETSC(MatSetNearNullSpace(K_, nsp));
+    MatNullSpaceDestroy(&nsp);
+    VecDestroy(&coords);
+  }
+  ANGIO_PETSC(VecScatterCreateToAll(du_, &scatter_, &full_));
+  ANGIO_PETSC(PetscOptionsCreate(&options_));
+  ANGIO_PETSC(PetscOptionsInsertString(options_, petsc_default_options()));
+  ANGIO_PETSC(PetscOptionsInsertString(options_, opt_.petsc_options.c_str()));
+  OptionsScope scope(options_);
+  ANGIO_PETSC(KSPCreate(comm_, &ksp_));
+  ANGIO_PETSC(KSPSetOperators(ksp_, K_, K_));
+  ANGIO_PETSC(KSPSetFromOptions(ksp_));
+}
+
+void SolidModel::add_pressure(PressureLoad load) {
+  const SurfaceSet* s = mesh_.surface(load.surface);
+  if (!s) throw std::runtime_error("pressure: unknown surface set '" + load.surface + "'");
+  LocalFaces lf;
+  for (const auto& f : s->faces)
+    if (node_owner_[f.n[0]] == rank_) lf.faces.push_back(f);
+  pressures_.push_back(std::move(load));
+  pressure_faces_.push_back(std::move(lf));
+}
+
+void SolidModel::add_springs(SpringSupport springs) {
+  const SurfaceSet* s = mesh_.surface(springs.surface);
+  if (!s) throw std::runtime_error("springs: unknown surface set '" + springs.surface + "'");
+  LocalFaces lf;
+  for (const auto& f : s->faces)
+    if (node_owner_[f.n[0]] == rank_) lf.faces.push_back(f);
+  springs_.push_back(std::move(springs));
+  spring_faces_.push_back(std::move(lf));
+}
+
+void SolidModel::add_dirichlet(DirichletBC bc) {
+  for (int n : bc.nodes) {
+    if (n < 0 || n >= int(mesh_.X.size())) throw std::runtime_error("dirichlet: node index out of range");
+    const int p = perm_[n];
+    if (p >= node_begin_ && p < node_end_) dirichlet_rows_.push_back(3 * p + bc.component);
+  }
+  std::sort(dirichlet_rows_.begin(), dirichlet_rows_.end());
+  dirichlet_rows_.erase(std::unique(dirichlet_rows_.begin(), dirichlet_rows_.end()), dirichlet_rows_.end());
+  dirichlet_.push_back(std::move(bc));
+}
+
+void SolidModel::apply_dirichlet_values_() {
+  for (const auto& bc : dirichlet_)
+    for (int n : bc.nodes) u_[dof(n, bc.component)] = bc.value(mesh_.X[n], time_);
+}
+
+Vec3d SolidModel::displacement(int node) const {
+  const int p = 3 * perm_[node];
+  return Vec3d(u_[p], u_[p + 1], u_[p + 2]);
+}
+
+void SolidModel::set_displacement(const std::vector<Vec3d>& u) {
+  for (size_t n = 0; n < mesh_.X.size(); ++n)
+    for (int k = 0; k < 3; ++k) u_[dof(int(n), k)] = u[n](k);
+}
+
+void SolidModel::gather_(Vec v, std::vector<double>& full) {
+  ANGIO_PETSC(VecScatterBegin(scatter_, v, full_, INSERT_VALUES, SCATTER_FORWARD));
+  ANGIO_PETSC(VecScatterEnd(scatter_, v, full_, INSERT_VALUES, SCATTER_FORWARD));
+  const PetscScalar* a;
+  PetscInt n;
+  ANGIO_PETSC(VecGetLocalSize(full_, &n));
+  ANGIO_PETSC(VecGetArrayRead(full_, &a));
+  full.assign(a, a + n);
+  ANGIO_PETSC(VecRestoreArrayRead(full_, &a));
+}
+
+bool SolidModel::assemble(Vec r, Mat K) {
+  ANGIO_PETSC(VecSet(r, 0.0));
+  if (K) ANGIO_PETSC(MatZeroEntries(K));
+  int ok = 1;
+  Eigen::MatrixXd X, u, Ke;
+  Eigen::VectorXd fe;
+  std::vector<PetscInt> idx;
+  auto gather_nodes = [&](const int* n, int nn, bool deformed) {
+    X.resize(nn, 3);
+    u.resize(nn, 3);
+    idx.resize(3 * nn);
+    for (int a = 0; a < nn; ++a) {
+      const int p = 3 * perm_[n[a]];
+      for (int k = 0; k < 3; ++k) {
+        X(a, k) = mesh_.X[n[a]](k);
+        u(a, k) = u_[p + k];
+        idx[3 * a + k] = p + k;
+      }
+    }
+    if (deformed) X += u;
+  };
+  auto add = [&](int nn) {
+    const PetscInt m = 3 * nn;
+    ANGIO_PETSC(VecSetValues(r, m, idx.data(), fe.data(), ADD_VALUES));
+    if (K) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
+  };
+  for (int e : local_elements_) {
+    const auto& el = mesh_.elements[e];
+    gather_nodes(el.n.data(), el.nn(), false);
+    const auto& mat = materials_[el.block].matrix;
+    if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr)) {
+      ok = 0;
+      break;
+    }
+    add(el.nn());
+  }
+  for (size_t i = 0; i < pressures_.size() && ok; ++i) {
+    const double p = pressures_[i].pressure(time_);
+    if (p == 0.0) continue;
+    for (const auto& f : pressure_faces_[i].faces) {
+      gather_nodes(f.n.data(), f.nn(), true);
+      face_pressure(f.type, X, p, fe, K ? &Ke : nullptr);
+      add(f.nn());
+    }
+  }
+  for (size_t i = 0; i < springs_.size() && ok; ++i) {
+    for (const auto& f : spring_faces_[i].faces) {
+      gather_nodes(f.n.data(), f.nn(), false);
+      face_springs(f.type, X, u, springs_[i].stiffness, fe, K ? &Ke : nullptr);
+      add(f.nn());
+    }
+  }
+  int all_ok = 0;
+  MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
+  if (all_ok && contact_) contact_->add(*this, r, K);
+  ANGIO_PETSC(VecAssemblyBegin(r));
+  ANGIO_PETSC(VecAssemblyEnd(r));
+  if (K) {
+    ANGIO_PETSC(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
+    ANGIO_PETSC(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
+  }
+  if (!dirichlet_rows_.empty() && apply_bc_) {
+    std::vector<PetscScalar> zeros(dirichlet_rows_.size(), 0.0);
+    ANGIO_PETSC(VecSetValues(r, PetscInt(zeros.size()), dirichlet_rows_.data(), zeros.data(), INSERT_VALUES));
+  }
+  ANGIO_PETSC(VecAssemblyBegin(r));
+  ANGIO_PETSC(VecAssemblyEnd(r));
+  if (K && apply_bc_)
+    ANGIO_PETSC(MatZeroRows(K, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, nullptr, nullptr));
+  return all_ok != 0;
+}
+
+SolveReport SolidModel::solve() {
+  SolveReport rep;
+  const double t_start = MPI_Wtime();
+  const auto& no = opt_.newton;
+  // Prescribed displacement increment: lifted through one linearised solve at the old state
+  // (du_D = increment, K_FD du_D moved to the right-hand side), so the first iterate is a
+  // consistent predictor instead of a boundary layer of distorted elements.
+  {
+    std::vector<double> u_target = u_;
+    std::swap(u_, u_target);
+    apply_dirichlet_values_();
+    std::swap(u_, u_target);  // u_target: Dirichlet values at the new time
+    int any = 0;
+    for (const auto& bc : dirichlet_)
+      for (int n : bc.nodes) {
+        const int d = dof(n, bc.component);
+        if (u_target[d] != u_[d]) any = 1;
+      }
+    int any_global = 0;
+    MPI_Allreduce(&any, &any_global, 1, MPI_INT, MPI_MAX, comm_);
+    if (any_global) {
+      apply_bc_ = false;
+      const double tl = MPI_Wtime();
+      const bool lok = assemble(r_, K_);
+      apply_bc_ = true;
+      rep.assembly_seconds += MPI_Wtime() - tl;
+      if (lok) {
+        std::vector<PetscScalar> inc(dirichlet_rows_.size());
+        for (size_t i = 0; i < dirichlet_rows_.size(); ++i) inc[i] = u_target[dirichlet_rows_[i]] - u_[dirichlet_rows_[i]];
+        ANGIO_PETSC(VecSet(du_, 0.0));
+        ANGIO_PETSC(VecSetValues(du_, PetscInt(inc.size()), dirichlet_rows_.data(), inc.data(), INSERT_VALUES));
+        ANGIO_PETSC(VecAssemblyBegin(du_));
+        ANGIO_PETSC(VecAssemblyEnd(du_));
+        ANGIO_PETSC(VecScale(r_, -1.0));
+        ANGIO_PETSC(MatZeroRowsColumns(K_, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, du_, r_));
+        KSPConvergedReason reason;
+        {
+          OptionsScope scope(options_);
+          ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+        }
+        ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
+        if (reason > 0 || reason == KSP_DIVERGED_ITS) {
+          std::vector<double> du_full;
+          gather_(du_, du_full);
+          bool finite = true;
+          for (double v : du_full) finite = finite && std::isfinite(v);
+          if (finite)
+            for (size_t i = 0; i < u_.size(); ++i) u_[i] += du_full[i];
+        }
+      }
+    }
+  }
+  apply_dirichlet_values_();
+  auto norm = [&](Vec v) {
+    PetscReal n;
+    ANGIO_PETSC(VecNorm(v, NORM_2, &n));
+    return double(n);
+  };
+  auto fail = [&](const std::string& msg) {
+    rep.converged = false;
+    rep.message = msg;
+    rep.total_seconds = MPI_Wtime() - t_start;
+    return rep;
+  };
+  double t0 = MPI_Wtime();
+  bool ok = assemble(r_, K_);
+  rep.assembly_seconds += MPI_Wtime() - t0;
+  if (!ok) return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN)");
+  double res = norm(r_);
+  if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
+  const double res0 = res;
+  rep.residual_history.push_back(res);
+  std::vector<double> du_full, u_base;
+  for (int it = 0;; ++it) {
+    rep.iterations = it;
+    rep.residual = res;
+    if (res <= no.atol || (it > 0 && res <= no.rtol * res0)) {
+      rep.converged = true;
+      rep.message = "converged";
+      break;
+    }
+    if (it >= no.max_iterations) {
+      std::ostringstream m;
+      m << "Newton did not converge in " << no.max_iterations << " iterations (residual " << res << ", initial "
+        << res0 << ")";
+      return fail(m.str());
+    }
+    // linear solve K du = -r
+    ANGIO_PETSC(VecScale(r_, -1.0));
+    t0 = MPI_Wtime();
+    KSPConvergedReason reason;
+    PetscInt lits;
+    {
+      OptionsScope scope(options_);
+      ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+    }
+    ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
+    ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
+    rep.linear_seconds += MPI_Wtime() - t0;
+    rep.linear_iterations += int(lits);
+    if (reason < 0 && reason != KSP_DIVERGED_ITS) {
+      std::ostringstream m;
+      m << "linear solver failed at Newton iteration " << it << ": " << KSPConvergedReasons[reason] << " after "
+        << lits << " iterations (residual " << res << ")";
+      return fail(m.str());
+    }
+    gather_(du_, du_full);
+    bool finite = true;
+    for (double v : du_full) finite = finite && std::isfinite(v);
+    if (!finite) return fail("linear solve produced NaN/Inf at Newton iteration " + std::to_string(it));
+    u_base = u_;
+    // line search (backtracking on ||r||); the tangent is assembled with the trial residual so
+    // that an accepted full step costs no extra assembly.
+    double alpha = 1.0, best_alpha = -1.0, best_res = std::numeric_limits<double>::infinity();
+    double new_res = 0.0;
+    bool accepted = false;
+    const int tries = no.line_search ? no.max_line_search + 1 : 1;
+    for (int ls = 0; ls < tries; ++ls) {
+      for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
+      t0 = MPI_Wtime();
+      const bool aok = assemble(r_, K_);
+      rep.assembly_seconds += MPI_Wtime() - t0;
+      new_res = aok ? norm(r_) : std::numeric_limits<double>::infinity();
+      if (!std::isfinite(new_res)) new_res = std::numeric_limits<double>::infinity();
+      if (new_res < best_res) {
+        best_res = new_res;
+        best_alpha = alpha;
+      }
+      if (new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res))) {
+        accepted = true;
+        break;
+      }
+      alpha *= 0.5;
+    }
+    if (!accepted) {
+      if (!std::isfinite(best_res))
+        return fail("Newton iteration " + std::to_string(it) +
+                    ": every line-search trial gave an invalid configuration (inverted element or NaN)");
+      if (best_alpha != 2.0 * alpha) {  // the last trial (2 alpha after the final halving) is not the best
+        for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + best_alpha * du_full[i];
+        t0 = MPI_Wtime();
+        assemble(r_, K_);
+        rep.assembly_seconds += MPI_Wtime() - t0;
+        new_res = norm(r_);
+      }
+    }
+    res = new_res;
+    rep.residual_history.push_back(res);
+    if (no.verbose && rank_ == 0)
+      std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d\n", it + 1, res,
+                  accepted ? alpha : best_alpha, int(lits));
+  }
+  rep.total_seconds = MPI_Wtime() - t_start;
+  return rep;
+}
+
+void SolidModel::commit() { u_committed_ = u_; }
+void SolidModel::rollback() { u_ = u_committed_; }
+
+void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir) const {
+  p1.resize(local_elements_.size());
+  dir.resize(local_elements_.size());
+  Eigen::MatrixXd X, u;
+  Eigen::VectorXd fe;
+  for (size_t i = 0; i < local_elements_.size(); ++i) {
+    const int e = local_elements_[i];
+    const auto& el = mesh_.elements[e];
+    X.resize(el.nn(), 3);
+    u.resize(el.nn(), 3);
+    for (int a = 0; a < el.nn(); ++a) {
+      X.row(a) = mesh_.X[el.n[a]].transpose();
+      u.row(a) = displacement(el.n[a]).transpose();
+    }
+    ElementStress es;
+    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, &es);
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(es.cauchy_avg);
+    p1[i] = eig.eigenvalues()(2);
+    dir[i] = eig.eigenvectors().col(2);
+  }
+}
+
+}  // namespace angio::solid

@@ -1,0 +1,211 @@
+#include "angio/solid/output.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace angio::solid {
+
+void make_directories(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create directory " + dir + ": " + ec.message());
+}
+
+namespace {
+void h5check(herr_t e, const char* what) {
+  if (e < 0) throw std::runtime_error(std::string("HDF5 error: ") + what);
+}
+hid_t h5check_id(hid_t id, const char* what) {
+  if (id < 0) throw std::runtime_error(std::string("HDF5 error: ") + what);
+  return id;
+}
+
+// Collective write of rows [offset, offset+local_rows) of a [total_rows, cols] dataset.
+template <class T>
+void write_rows(hid_t file, const std::string& path, hid_t type, long total_rows, int cols, long offset,
+                long local_rows, const T* data) {
+  hsize_t dims[2] = {hsize_t(total_rows), hsize_t(cols)};
+  const int rank = cols > 1 ? 2 : 1;
+  hid_t space = h5check_id(H5Screate_simple(rank, dims, nullptr), "create space");
+  hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);
+  H5Pset_create_intermediate_group(lcpl, 1);
+  hid_t ds = h5check_id(H5Dcreate2(file, path.c_str(), type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT), path.c_str());
+  H5Pclose(lcpl);
+  hsize_t start[2] = {hsize_t(offset), 0}, count[2] = {hsize_t(local_rows), hsize_t(cols)};
+  if (local_rows > 0)
+    h5check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr), "hyperslab");
+  else
+    H5Sselect_none(space);
+  hid_t mem = H5Screate_simple(rank, count, nullptr);
+  if (local_rows == 0) H5Sselect_none(mem);
+  hid_t xfer = H5Pcreate(H5P_DATASET_XFER);
+  H5Pset_dxpl_mpio(xfer, H5FD_MPIO_COLLECTIVE);
+  h5check(H5Dwrite(ds, type, mem, space, xfer, data), path.c_str());
+  H5Pclose(xfer);
+  H5Sclose(mem);
+  H5Sclose(space);
+  H5Dclose(ds);
+}
+
+const char* xdmf_topology(ElemType t) {
+  switch (t) {
+    case ElemType::Hex8: return "Hexahedron";
+    case ElemType::Tet4: return "Tetrahedron";
+    case ElemType::Tet10: return "Tetrahedron_10";
+  }
+  return "";
+}
+}  // namespace
+
+FieldWriter::FieldWriter(const SolidModel& model, const std::string& dir) : model_(model), dir_(dir) {
+  MPI_Comm comm = model.comm();
+  if (model.rank() == 0) make_directories(dir);
+  MPI_Barrier(comm);
+  hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
+  file_ = H5Fcreate((dir + "/solid.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+  H5Pclose(fapl);
+  if (file_ < 0) throw std::runtime_error("cannot create " + dir + "/solid.h5");
+  const auto& mesh = model.mesh();
+  // nodes: rank owns [owned_node_begin, owned_node_end) in the new numbering
+  const long n0 = model.owned_node_begin(), n1 = model.owned_node_end(), N = long(mesh.X.size());
+  std::vector<double> xyz(3 * (n1 - n0));
+  std::vector<int> orig(n1 - n0);
+  for (long i = n0; i < n1; ++i) {
+    const int o = model.old_index(int(i));
+    orig[i - n0] = o;
+    for (int k = 0; k < 3; ++k) xyz[3 * (i - n0) + k] = mesh.X[o](k);
+  }
+  write_rows(file_, "/mesh/coordinates", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, xyz.data());
+  write_rows(file_, "/mesh/original_node_id", H5T_NATIVE_INT, N, 1, n0, n1 - n0, orig.data());
+  // element types present anywhere
+  for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
+    TypeInfo ti{t, 0, 0, {}};
+    const auto& le = model.local_elements();
+    for (size_t i = 0; i < le.size(); ++i)
+      if (mesh.elements[le[i]].type == t) ti.local.push_back(int(i));
+    long nloc = long(ti.local.size());
+    MPI_Allreduce(&nloc, &ti.total, 1, MPI_LONG, MPI_SUM, comm);
+    MPI_Exscan(&nloc, &ti.offset, 1, MPI_LONG, MPI_SUM, comm);
+    if (model.rank() == 0) ti.offset = 0;
+    if (ti.total == 0) continue;
+    const int nn = num_nodes(t);
+    std::vector<int> conn(nn * nloc), block(nloc), oid(nloc);
+    static const int vtk_tet10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};  // gmsh 8=(3,2),9=(3,1) -> VTK 8=(1,3),9=(2,3)
+    for (long i = 0; i < nloc; ++i) {
+      const int e = le[ti.local[i]];
+      const auto& el = mesh.elements[e];
+      for (int a = 0; a < nn; ++a) {
+        const int src = t == ElemType::Tet10 ? vtk_tet10[a] : a;
+        conn[nn * i + a] = model.new_index(el.n[src]);
+      }
+      block[i] = el.block;
+      oid[i] = e;
+    }
+    const std::string base = std::string("/mesh/") + name(t);
+    write_rows(file_, base + "/connectivity", H5T_NATIVE_INT, ti.total, nn, ti.offset, nloc, conn.data());
+    write_rows(file_, base + "/block_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc, block.data());
+    write_rows(file_, base + "/original_element_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc, oid.data());
+    types_.push_back(std::move(ti));
+  }
+  H5Fflush(file_, H5F_SCOPE_GLOBAL);
+}
+
+FieldWriter::~FieldWriter() {
+  try {
+    close();
+  } catch (...) {
+  }
+}
+
+void FieldWriter::close() {
+  if (file_ >= 0) {
+    H5Fclose(file_);
+    file_ = -1;
+  }
+}
+
+void FieldWriter::write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir) {
+  const std::string g = "/steps/" + std::to_string(step);
+  const long n0 = model_.owned_node_begin(), n1 = model_.owned_node_end(), N = long(model_.mesh().X.size());
+  std::vector<double> u(3 * (n1 - n0));
+  for (long i = n0; i < n1; ++i) {
+    const Vec3d d = model_.displacement(model_.old_index(int(i)));
+    for (int k = 0; k < 3; ++k) u[3 * (i - n0) + k] = d(k);
+  }
+  write_rows(file_, g + "/displacement", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, u.data());
+  for (const auto& ti : types_) {
+    const long nloc = long(ti.local.size());
+    std::vector<double> s(nloc), d(3 * nloc);
+    for (long i = 0; i < nloc; ++i) {
+      s[i] = p1[ti.local[i]];
+      for (int k = 0; k < 3; ++k) d[3 * i + k] = dir[ti.local[i]](k);
+    }
+    const std::string base = g + "/" + name(ti.type);
+    write_rows(file_, base + "/stress_p1", H5T_NATIVE_DOUBLE, ti.total, 1, ti.offset, nloc, s.data());
+    write_rows(file_, base + "/stress_p1_dir", H5T_NATIVE_DOUBLE, ti.total, 3, ti.offset, nloc, d.data());
+  }
+  {  // pseudo-time as an attribute of the step group (collective, same value on all ranks)
+    hid_t grp = H5Gopen2(file_, g.c_str(), H5P_DEFAULT);
+    hid_t sp = H5Screate(H5S_SCALAR);
+    hid_t at = H5Acreate2(grp, "time", H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(at, H5T_NATIVE_DOUBLE, &time);
+    H5Aclose(at);
+    H5Sclose(sp);
+    H5Gclose(grp);
+  }
+  H5Fflush(file_, H5F_SCOPE_GLOBAL);
+  steps_.emplace_back(step, time);
+  if (model_.rank() == 0) write_xdmf_();
+}
+
+void FieldWriter::write_xdmf_() {
+  const long N = long(model_.mesh().X.size());
+  std::ostringstream x;
+  x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
+    << "  <Grid Name=\"solid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const auto& [step, time] : steps_) {
+    const std::string g = "solid.h5:/steps/" + std::to_string(step);
+    x << "   <Grid Name=\"step_" << step << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+      << "    <Time Value=\"" << time << "\"/>\n";
+    for (const auto& ti : types_) {
+      const std::string tn = name(ti.type);
+      const int nn = num_nodes(ti.type);
+      x << "    <Grid Name=\"" << tn << "\" GridType=\"Uniform\">\n"
+        << "     <Topology TopologyType=\"" << xdmf_topology(ti.type) << "\" NumberOfElements=\"" << ti.total
+        << "\">\n      <DataItem Dimensions=\"" << ti.total << " " << nn
+        << "\" NumberType=\"Int\" Format=\"HDF\">solid.h5:/mesh/" << tn << "/connectivity</DataItem>\n"
+        << "     </Topology>\n"
+        << "     <Geometry GeometryType=\"XYZ\">\n      <DataItem Dimensions=\"" << N
+        << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">solid.h5:/mesh/coordinates</DataItem>\n"
+        << "     </Geometry>\n"
+        << "     <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n      <DataItem Dimensions=\""
+        << N << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/displacement</DataItem>\n"
+        << "     </Attribute>\n"
+        << "     <Attribute Name=\"block_id\" AttributeType=\"Scalar\" Center=\"Cell\">\n      <DataItem Dimensions=\""
+        << ti.total << "\" NumberType=\"Int\" Format=\"HDF\">solid.h5:/mesh/" << tn << "/block_id</DataItem>\n"
+        << "     </Attribute>\n"
+        << "     <Attribute Name=\"stress_p1\" AttributeType=\"Scalar\" Center=\"Cell\">\n      <DataItem Dimensions=\""
+        << ti.total << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/" << tn
+        << "/stress_p1</DataItem>\n"
+        << "     </Attribute>\n"
+        << "     <Attribute Name=\"stress_p1_dir\" AttributeType=\"Vector\" Center=\"Cell\">\n      <DataItem Dimensions=\""
+        << ti.total << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/" << tn
+        << "/stress_p1_dir</DataItem>\n"
+        << "     </Attribute>\n"
+        << "    </Grid>\n";
+    }
+    x << "   </Grid>\n";
+  }
+  x << "  </Grid>\n </Domain>\n</Xdmf>\n";
+  const std::string tmp = dir_ + "/solid.xdmf.tmp";
+  {
+    std::ofstream f(tmp);
+    f << x.str();
+  }
+  std::filesystem::rename(tmp, dir_ + "/solid.xdmf");
+}
+
+}  // namespace angio::solid

@@ -1,0 +1,310 @@
+#include "angio/solid/scene.hpp"
+
+#include <cmath>
+#include <limits>
+#include <set>
+
+namespace angio::solid {
+
+namespace {
+using scene::Node;
+
+Vec3d v3(const std::array<double, 3>& a) { return Vec3d(a[0], a[1], a[2]); }
+
+LayerMaterial read_material(const Node& n, const std::string& name) {
+  n.check_keys({"E", "nu", "fibers", "viscous"});
+  LayerMaterial m;
+  m.name = name;
+  m.matrix.E = n.positive("E");
+  m.matrix.nu = n.number_or("nu", 0.0);
+  if (!(m.matrix.nu >= 0.0 && m.matrix.nu < 0.5)) n.child("nu").fail("a Poisson's ratio in [0, 0.5)");
+  if (n.has("viscous")) n.child("viscous").fail("no 'viscous' entry (the viscous branch is not implemented yet)");
+  if (auto f = n.optional("fibers")) {
+    if (!f->is_sequence()) f->fail("a list of fiber families {k1, k2, angle, pair}");
+    for (size_t i = 0; i < f->size(); ++i) {
+      const Node fi = f->at(i);
+      fi.check_keys({"k1", "k2", "angle", "pair"});
+      FiberSpec s;
+      s.k1 = fi.non_negative("k1");
+      s.k2 = fi.positive("k2");
+      s.angle_deg = fi.in_range("angle", -90.0, 90.0);
+      s.pair = fi.boolean_or("pair", false);
+      m.fibers.push_back(s);
+    }
+  }
+  return m;
+}
+
+Axis read_axis(const Node& parent, const Vec3d& default_origin) {
+  Axis a{default_origin, Vec3d::UnitZ()};
+  if (auto n = parent.optional("axis")) {
+    n->check_keys({"origin", "direction"});
+    if (n->has("origin")) a.origin = v3(n->vec3("origin"));
+    if (n->has("direction")) {
+      a.direction = v3(n->vec3("direction"));
+      if (a.direction.norm() < 1e-12) n->child("direction").fail("a non-zero vector");
+      a.direction.normalize();
+    }
+  }
+  return a;
+}
+
+// mesh: {generator: tube, ...} or {file: x.msh, ...}; returns the mesh with part-prefixed surfaces.
+Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axis& axis,
+                    std::vector<std::string>& required_surfaces, double& length) {
+  const std::string prefix = part + "_";
+  if (mesh.has("file")) {
+    mesh.check_keys({"file", "scale", "inner", "outer", "ends", "axis", "centerline"});
+    const std::string path = scene::resolve_path(mesh, mesh.string("file"));
+    Mesh m;
+    try {
+      m = read_gmsh(path, part, prefix, mesh.positive_or("scale", 1.0));
+    } catch (const std::exception& e) {
+      mesh.child("file").fail(std::string("a readable gmsh 4.x ASCII mesh (") + e.what() + ")");
+    }
+    axis = read_axis(mesh, Vec3d::Zero());
+    if (auto cl = mesh.optional("centerline")) {
+      // fiber frames from a lumen centerline (patient-specific arteries): list of points [x, y, z]
+      if (!cl->is_sequence() || cl->size() < 2) cl->fail("a list of at least two points [x, y, z]");
+      std::vector<Vec3d> pts;
+      for (size_t i = 0; i < cl->size(); ++i) pts.push_back(v3(cl->at(i).as_vec3()));
+      set_frames_from_centerline(m, pts);
+    } else {
+      set_frames_from_axis(m, axis);
+    }
+    double smin = std::numeric_limits<double>::max(), smax = -smin;
+    for (const auto& x : m.X) {
+      const double s = (x - axis.origin).dot(axis.direction);
+      smin = std::min(smin, s);
+      smax = std::max(smax, s);
+    }
+    length = smax - smin;
+    // rename the named surfaces to the canonical names used by the loads
+    auto rename = [&](const std::string& key, const std::string& canonical) {
+      const std::string given = prefix + mesh.string(key);
+      for (auto& s : m.surfaces)
+        if (s.name == given) {
+          s.name = canonical;
+          return;
+        }
+      mesh.child(key).fail("the name of a surface physical group in " + path);
+    };
+    rename("inner", prefix + "inner");
+    if (mesh.has("outer")) {
+      rename("outer", prefix + "outer");
+      std::set<int> nodes;
+      for (const auto& f : m.surface(prefix + "outer")->faces)
+        for (int a = 0; a < f.nn(); ++a) nodes.insert(f.n[a]);
+      m.node_sets[prefix + "outer"] = std::vector<int>(nodes.begin(), nodes.end());
+    }
+    if (mesh.has("ends")) {
+      const auto ends = mesh.child("ends");
+      if (!ends.is_sequence() || ends.size() != 2) ends.fail("a list of two surface names [end0, end1]");
+      for (int i = 0; i < 2; ++i) {
+        const std::string given = prefix + ends.at(i).as_string();
+        bool found = false;
+        for (auto& s : m.surfaces)
+          if (s.name == given) {
+            s.name = prefix + "end" + std::to_string(i);
+            found = true;
+          }
+        if (!found) ends.at(i).fail("the name of a surface physical group in " + path);
+      }
+    }
+    (void)required_surfaces;
+    return m;
+  }
+  mesh.check_keys(layered ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ",
+                                                               "n_axial", "center", "layers"}
+                          : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall",
+                                                               "n_circ", "n_axial", "center"});
+  mesh.choice("generator", {"tube"});
+  TubeSpec t;
+  t.part = part;
+  t.surface_prefix = prefix;
+  t.length = mesh.positive("length");
+  const double ro = 0.5 * mesh.positive("outer_diameter");
+  t.n_circ = int(mesh.integer("n_circ", 3));
+  t.n_axial = int(mesh.integer("n_axial", 1));
+  if (mesh.has("center")) t.center = v3(mesh.vec3("center"));
+  double wall = 0.0;
+  if (layered) {
+    const Node layers = mesh.child("layers", "a list of layers {name, thickness, n_radial} from inside out");
+    if (!layers.is_sequence() || layers.size() == 0) layers.fail("a non-empty list of layers {name, thickness, n_radial}");
+    for (size_t i = 0; i < layers.size(); ++i) {
+      const Node l = layers.at(i);
+      l.check_keys({"name", "thickness", "n_radial"});
+      TubeLayer tl;
+      tl.name = l.string("name");
+      tl.thickness = l.positive("thickness");
+      tl.n_radial = int(l.integer_or("n_radial", 1, 1));
+      wall += tl.thickness;
+      t.layers.push_back(tl);
+    }
+  } else {
+    wall = mesh.positive("wall");
+    t.layers = {{part, wall, 1}};
+  }
+  t.inner_radius = ro - wall;
+  if (!(t.inner_radius > 0)) mesh.child("outer_diameter").fail("an outer diameter larger than twice the wall thickness");
+  axis = Axis{t.center, Vec3d::UnitZ()};
+  length = t.length;
+  return make_tube(t);
+}
+
+PressureSpec read_pressure(const Node& parent, const std::string& key, const std::string& surface,
+                           const scene::LoadCurves& curves, const std::string& label) {
+  const Node n = parent.child(key);
+  PressureSpec p;
+  p.surface = surface;
+  p.label = label;
+  if (n.is_scalar()) {
+    p.value = n.as_number();
+    p.curve = scene::LoadCurve::constant(1.0);
+  } else {
+    n.check_keys({"value", "curve"});
+    p.value = n.number_or("value", 1.0);
+    p.curve = scene::curve_ref(n, "curve", curves);
+  }
+  return p;
+}
+
+// fixed: [{surface: end0, components: [x, y, z]}, ...]  (surface names without the part prefix)
+void read_fixed(const Node& part, const std::string& prefix, const Mesh& m, std::vector<FixedSpec>& out) {
+  const auto f = part.optional("fixed");
+  if (!f) return;
+  if (!f->is_sequence()) f->fail("a list of {surface, components}");
+  for (size_t i = 0; i < f->size(); ++i) {
+    const Node e = f->at(i);
+    e.check_keys({"surface", "components"});
+    FixedSpec fs;
+    fs.surface = prefix + e.string("surface");
+    if (!m.surface(fs.surface)) e.child("surface").fail("a surface set of this part (e.g. inner, outer, end0, end1)");
+    if (e.has("components")) {
+      const Node c = e.child("components");
+      if (!c.is_sequence()) c.fail("a list of components out of x, y, z");
+      for (size_t k = 0; k < c.size(); ++k) {
+        const std::string v = c.at(k).as_string();
+        if (v != "x" && v != "y" && v != "z") c.at(k).fail("x, y or z");
+        fs.components.push_back(v == "x" ? 0 : v == "y" ? 1 : 2);
+      }
+    } else {
+      fs.components = {0, 1, 2};
+    }
+    out.push_back(fs);
+  }
+}
+
+}  // namespace
+
+SolidScene read_solid_scene(const Node& root) {
+  SolidScene sc;
+  sc.time = scene::time_settings(root);
+  const auto curves = scene::load_curves(root);
+  if (auto out = root.optional("output")) sc.output_every = int(out->integer_or("every", 1, 1));
+
+  if (auto b = root.optional("balloon")) {
+    sc.has_balloon = true;
+    b->check_keys({"mesh", "material", "pressure", "end_springs", "summary", "fixed"});
+    Axis axis;
+    std::vector<std::string> req;
+    double length = 0;
+    Mesh m = read_part_mesh(b->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false,
+                            axis, req, length);
+    for (auto& blk : m.blocks) blk.name = m.blocks.size() == 1 ? "balloon" : "balloon_" + blk.name;
+    const LayerMaterial mat = read_material(b->child("material", "a material {E, nu, fibers}"), "balloon");
+    const int boff = int(sc.mesh.blocks.size());
+    for (size_t i = 0; i < m.blocks.size(); ++i) {
+      LayerMaterial mi = mat;
+      mi.name = m.blocks[i].name;
+      sc.materials.push_back(mi);
+    }
+    (void)boff;
+    if (b->has("pressure")) sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure"));
+    if (b->has("end_springs")) {
+      const double k = b->positive("end_springs");
+      for (const char* s : {"balloon_end0", "balloon_end1"}) {
+        if (!m.surface(s)) b->child("end_springs").fail("balloon end surfaces (mesh.ends) for the springs");
+        sc.springs.push_back({s, k});
+      }
+    }
+    if (m.node_sets.count("balloon_outer")) {
+      DiameterSpec d;
+      d.node_set = "balloon_outer";
+      d.axis = axis;
+      double smin = std::numeric_limits<double>::max(), smax = -smin;
+      for (const auto& x : m.X) {
+        const double s = (x - axis.origin).dot(axis.direction);
+        smin = std::min(smin, s);
+        smax = std::max(smax, s);
+      }
+      double end_offset = std::min(1.7, 0.25 * (smax - smin));
+      if (auto s = b->optional("summary")) {
+        s->check_keys({"end_offset"});
+        end_offset = s->non_negative_or("end_offset", end_offset);
+        if (!(2 * end_offset < smax - smin)) s->child("end_offset").fail("an offset smaller than half the balloon length");
+      }
+      d.s_mid = 0.5 * (smin + smax);
+      d.s_end0 = smin + end_offset;
+      d.s_end1 = smax - end_offset;
+      sc.balloon_diameter = d;
+    }
+    read_fixed(*b, "balloon_", m, sc.fixed);
+    sc.mesh.append(m);
+  }
+
+  if (auto a = root.optional("artery")) {
+    sc.has_artery = true;
+    a->check_keys({"mesh", "layers", "blood_pressure", "end_springs", "fixed"});
+    Axis axis;
+    std::vector<std::string> req;
+    double length = 0;
+    Mesh m = read_part_mesh(a->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis,
+                            req, length);
+    const Node layers = a->child("layers", "a map layer name -> material {E, nu, fibers}");
+    if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
+    for (const auto& blk : m.blocks) {
+      if (!layers.has(blk.name)) layers.fail("a material for layer '" + blk.name + "'");
+      sc.materials.push_back(read_material(layers.child(blk.name), blk.name));
+    }
+    for (const auto& k : layers.keys())
+      if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
+    if (a->has("blood_pressure"))
+      sc.pressures.push_back(read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure"));
+    if (a->has("end_springs")) {
+      const double k = a->positive("end_springs");
+      for (const char* s : {"artery_end0", "artery_end1"}) {
+        if (!m.surface(s)) a->child("end_springs").fail("artery end surfaces (mesh.ends) for the springs");
+        sc.springs.push_back({s, k});
+      }
+    }
+    read_fixed(*a, "artery_", m, sc.fixed);
+    sc.mesh.append(m);
+  }
+  if (!sc.has_balloon && !sc.has_artery) root.fail("a scene with a 'balloon:' and/or 'artery:' section for the solid solver");
+  for (size_t i = 0; i < sc.mesh.blocks.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (sc.mesh.blocks[i].name == sc.mesh.blocks[j].name)
+        root.fail("unique block names (balloon and artery both have a block '" + sc.mesh.blocks[i].name + "')");
+
+  if (auto s = root.optional("solid")) {
+    s->check_keys({"ranks", "partitioner", "petsc_options", "newton"});
+    sc.ranks = int(s->integer_or("ranks", 0, 1));
+    sc.options.partitioner = s->choice_or("partitioner", {"contiguous", "ptscotch", "parmetis", "average", "square"},
+                                          "contiguous");
+    sc.options.petsc_options = s->string_or("petsc_options", "");
+    if (auto n = s->optional("newton")) {
+      n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose"});
+      auto& no = sc.options.newton;
+      no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
+      no.rtol = n->positive_or("rtol", no.rtol);
+      no.atol = n->positive_or("atol", no.atol);
+      no.line_search = n->boolean_or("line_search", no.line_search);
+      no.max_line_search = int(n->integer_or("max_line_search", no.max_line_search, 0));
+      no.verbose = n->boolean_or("verbose", no.verbose);
+    }
+  }
+  return sc;
+}
+
+}  // namespace angio::solid

@@ -1,0 +1,301 @@
+// Tests of the distributed solid model (PETSc + MPI). Run under mpirun with 1 or 2 ranks.
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <petscsys.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+
+#include "angio/scene/node.hpp"
+#include "angio/solid/model.hpp"
+#include "angio/solid/participant.hpp"
+#include "angio/solid/scene.hpp"
+
+using namespace angio::solid;
+
+namespace angio_test {
+Mesh cube_mesh(ElemType t, int n, double perturb, unsigned seed);
+}
+
+namespace {
+int world_rank() {
+  int r;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &r);
+  return r;
+}
+int world_size() {
+  int s;
+  MPI_Comm_size(PETSC_COMM_WORLD, &s);
+  return s;
+}
+ModelOptions direct_options() {
+  ModelOptions o;
+  o.petsc_options = "-ksp_rtol 1e-12";
+  o.newton.rtol = 1e-10;
+  o.newton.atol = 1e-12;
+  return o;
+}
+}  // namespace
+
+// Patch test through the whole distributed path: boundary nodes prescribed to the homogeneous
+// finite deformation u = G X (Dirichlet); the interior nodes must follow it exactly.
+TEST(Model, PatchTestSolveAllElementTypes) {
+  Mat3 G;
+  G << 0.12, 0.05, -0.03, 0.02, -0.08, 0.04, 0.06, 0.01, 0.10;
+  for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
+    Mesh m = angio_test::cube_mesh(t, 3, 0.08, 5);
+    const auto boundary = m.node_sets.at("boundary");
+    m.frames.assign(m.elements.size(), Frame{});  // homogeneous material (same fiber directions everywhere)
+    LayerMaterial mat{"cube", {1.0, 0.4}, {{0.3, 1.0, 20.0, true}}};
+    SolidModel model(PETSC_COMM_WORLD, m, {mat}, direct_options());
+    for (int c = 0; c < 3; ++c)
+      model.add_dirichlet({boundary, c, [G, c](const Vec3d& X, double t) { return t * (G * X)(c); }});
+    // one load step: the prescribed increment is lifted through a linearised predictor
+    for (double time : {1.0}) {
+      model.set_time(time);
+      const SolveReport rep = model.solve();
+      ASSERT_TRUE(rep.converged) << name(t) << ": " << rep.message;
+      model.commit();
+    }
+    double err = 0;
+    for (size_t n = 0; n < m.X.size(); ++n) err = std::max(err, (model.displacement(int(n)) - G * m.X[n]).norm());
+    EXPECT_LT(err, 1e-8) << name(t);
+  }
+}
+
+// Uniaxial compression of a distorted unit cube by a small follower pressure p on the face x = 1
+// (quad4 / tri3 / tri6 faces), rollers on x = 0, y = 0, z = 0: compared with the linear-elastic
+// solution u_x(1) = -p/E, u_y(y=1) = +nu p/E (homogeneous stress, exact for every element type up to
+// the O(p^2) geometric nonlinearity).
+TEST(Model, PressureOnCubeAllFaceTypes) {
+  const double E = 2.0, nu = 0.3, p = 2e-5;
+  for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
+    Mesh m = angio_test::cube_mesh(t, 2, 0.08, 9);
+    SurfaceSet right{"right", {}};
+    for (const auto& el : m.elements)
+      for (const auto& lf : local_faces(el.type)) {
+        Face f;
+        f.type = lf.type;
+        bool on = true;
+        for (size_t a = 0; a < lf.nodes.size(); ++a) {
+          f.n[a] = el.n[lf.nodes[a]];
+          on = on && std::abs(m.X[f.n[a]].x() - 1.0) < 1e-12;
+        }
+        if (on) right.faces.push_back(f);
+      }
+    ASSERT_FALSE(right.faces.empty());
+    m.surfaces.push_back(right);
+    m.orient_surfaces();
+    SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {E, nu}, {}}}, direct_options());
+    for (int c = 0; c < 3; ++c) {
+      std::vector<int> plane;
+      for (size_t n = 0; n < m.X.size(); ++n)
+        if (std::abs(m.X[n](c)) < 1e-12) plane.push_back(int(n));
+      model.add_dirichlet({plane, c, [](const Vec3d&, double) { return 0.0; }});
+    }
+    model.add_pressure({"right", [p](double) { return p; }});
+    model.set_time(1.0);
+    const auto rep = model.solve();
+    ASSERT_TRUE(rep.converged) << rep.message;
+    for (size_t n = 0; n < m.X.size(); ++n) {
+      const Vec3d X = m.X[n], u = model.displacement(int(n));
+      EXPECT_NEAR(u.x(), -p / E * X.x(), 1e-3 * p / E) << name(t);
+      EXPECT_NEAR(u.y(), nu * p / E * X.y(), 1e-3 * p / E) << name(t);
+    }
+  }
+}
+
+// Thick-walled cylinder, plane strain, small internal pressure: compared with Lame's linear-elastic
+// solution u_r(r) = (1+nu)/E [(1-2nu) A r + B/r], A = p a^2/(b^2-a^2), B = p a^2 b^2/(b^2-a^2).
+TEST(Model, ThickCylinderMatchesLame) {
+  const double a = 1.0, b = 2.0, E = 1.0, nu = 0.3, p = 1e-4;
+  TubeSpec s;
+  s.part = "cyl";
+  s.surface_prefix = "cyl_";
+  s.length = 0.2;
+  s.inner_radius = a;
+  s.layers = {{"wall", b - a, 8}};
+  s.n_circ = 64;
+  s.n_axial = 1;
+  Mesh m = make_tube(s);
+  std::vector<int> all(m.X.size()), xzero, yzero;
+  for (size_t n = 0; n < m.X.size(); ++n) {
+    all[n] = int(n);
+    if (std::abs(m.X[n].x()) < 1e-9) xzero.push_back(int(n));
+    if (std::abs(m.X[n].y()) < 1e-9) yzero.push_back(int(n));
+  }
+  SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"wall", {E, nu}, {}}}, direct_options());
+  auto zero = [](const Vec3d&, double) { return 0.0; };
+  model.add_dirichlet({all, 2, zero});
+  model.add_dirichlet({xzero, 0, zero});
+  model.add_dirichlet({yzero, 1, zero});
+  model.add_pressure({"cyl_inner", [p](double t) { return p * t; }});
+  model.set_time(1.0);
+  const SolveReport rep = model.solve();
+  ASSERT_TRUE(rep.converged) << rep.message;
+  const double A = p * a * a / (b * b - a * a), B = p * a * a * b * b / (b * b - a * a);
+  auto ur = [&](double r) { return (1 + nu) / E * ((1 - 2 * nu) * A * r + B / r); };
+  double max_rel = 0;
+  for (size_t n = 0; n < m.X.size(); ++n) {
+    const Vec3d X = m.X[n];
+    const double r = std::hypot(X.x(), X.y());
+    const Vec3d u = model.displacement(int(n));
+    const double urn = (u.x() * X.x() + u.y() * X.y()) / r;
+    max_rel = std::max(max_rel, std::abs(urn - ur(r)) / ur(a));
+  }
+  EXPECT_LT(max_rel, 0.01);  // faceted circle (64 sides) and hex8 discretisation error
+}
+
+// The same nonlinear problem (two-layer fibered tube under internal follower pressure, springs on
+// the ends) on all ranks of the world communicator and on one rank gives the same displacements.
+TEST(Model, OneAndTwoRanksGiveSameDisplacements) {
+  if (world_size() < 2) GTEST_SKIP() << "needs 2 MPI ranks";
+  TubeSpec s;
+  s.part = "artery";
+  s.surface_prefix = "artery_";
+  s.length = 3.0;
+  s.inner_radius = 0.8;
+  s.layers = {{"media", 0.3, 1}, {"adventitia", 0.3, 1}};
+  s.n_circ = 16;
+  s.n_axial = 8;
+  const Mesh m = make_tube(s);
+  const std::vector<LayerMaterial> mats = {{"media", {0.1566, 0.45}, {{0.00064, 3.54, 0.0, true}}},
+                                           {"adventitia", {0.01566, 0.45}, {{0.0051, 15.4, 40.0, true}}}};
+  auto run = [&](MPI_Comm comm, const std::string& partitioner) {
+    ModelOptions o = direct_options();
+    o.partitioner = partitioner;
+    SolidModel model(comm, m, mats, o);
+    model.add_pressure({"artery_inner", [](double t) { return 0.03 * t; }});
+    model.add_springs({"artery_end0", 1e3});
+    model.add_springs({"artery_end1", 1e3});
+    std::vector<Vec3d> u(m.X.size());
+    for (double t : {0.5, 1.0}) {
+      model.set_time(t);
+      const auto rep = model.solve();
+      EXPECT_TRUE(rep.converged) << rep.message;
+      model.commit();
+    }
+    for (size_t n = 0; n < m.X.size(); ++n) u[n] = model.displacement(int(n));
+    return u;
+  };
+  const auto u_par = run(PETSC_COMM_WORLD, "contiguous");
+  const auto u_part = run(PETSC_COMM_WORLD, "ptscotch");
+  MPI_Comm serial;
+  MPI_Comm_split(PETSC_COMM_WORLD, world_rank() == 0 ? 0 : MPI_UNDEFINED, 0, &serial);
+  if (world_rank() == 0) {
+    const auto u_ser = run(serial, "contiguous");
+    double umax = 0, d1 = 0, d2 = 0;
+    for (size_t n = 0; n < u_ser.size(); ++n) {
+      umax = std::max(umax, u_ser[n].norm());
+      d1 = std::max(d1, (u_ser[n] - u_par[n]).norm());
+      d2 = std::max(d2, (u_ser[n] - u_part[n]).norm());
+    }
+    EXPECT_GT(umax, 0.01);
+    EXPECT_LT(d1, 1e-8 * umax);
+    EXPECT_LT(d2, 1e-8 * umax);
+    MPI_Comm_free(&serial);
+  }
+}
+
+// Scene -> runner -> HDF5/XDMF/summary.json on the communicator, two committed steps, one rejected.
+TEST(Runner, WritesOutputAndRollsBack) {
+  const std::string dir = "solid_runner_test_out";
+  const std::string scene_file = std::string(ANGIO_SOLID_TEST_DATA) + "/small_artery.yaml";
+  const auto root = angio::scene::load_scene(scene_file);
+  SolidScene sc = read_solid_scene(root);
+  SolidRunner runner(PETSC_COMM_WORLD, sc, dir);
+  angio::participant::ContactReply reply;
+  runner.begin_step(1, 0.5);
+  auto st = runner.solve({}, reply);
+  ASSERT_TRUE(st.converged) << st.message;
+  runner.end_step(true);
+  const Vec3d u1 = runner.model().displacement(0);
+  runner.begin_step(2, 1.0);
+  st = runner.solve({}, reply);
+  ASSERT_TRUE(st.converged);
+  runner.end_step(false);  // rejected: back to step 1
+  EXPECT_LT((runner.model().displacement(0) - u1).norm(), 1e-15);
+  st = runner.solve({}, reply);
+  runner.end_step(true);
+  runner.finish();
+  ASSERT_EQ(runner.history().size(), 3u);
+  // scene `fixed: [{surface: end0, components: [z]}]`
+  const auto& f0 = runner.model().mesh().surface("artery_end0")->faces.front();
+  EXPECT_EQ(runner.model().displacement(f0.n[0]).z(), 0.0);
+  EXPECT_NE(runner.model().displacement(f0.n[0]).x(), 0.0);
+  EXPECT_GT(runner.history()[2].max_p1[0], runner.history()[1].max_p1[0]);
+  MPI_Barrier(PETSC_COMM_WORLD);
+  if (world_rank() == 0) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/solid/solid.h5"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/solid/solid.xdmf"));
+    std::ifstream f(dir + "/solid/summary.json");
+    std::string s((std::istreambuf_iterator<char>(f)), {});
+    EXPECT_NE(s.find("\"media\""), std::string::npos);
+    EXPECT_NE(s.find("\"step\": 2"), std::string::npos);
+  }
+}
+
+// Coupled mode: rank 0 drives the participant through MpiSolidParticipant (as the role server
+// would), the other ranks run run_follower(); compared with every rank calling the runner directly.
+TEST(Runner, LeaderFollowerMatchesCollectiveCalls) {
+  if (world_size() < 2) GTEST_SKIP() << "needs 2 MPI ranks";
+  const auto root = angio::scene::load_scene(std::string(ANGIO_SOLID_TEST_DATA) + "/small_artery.yaml");
+  angio::participant::ContactReply reply;
+  angio::participant::SamplePoints pts;
+  pts.x = {{0.0, 0.0, 0.0}, {0.1, 0.0, 0.0}};
+  pts.w = {0.1, 0.1};
+  pts.radius = {0.06, 0.06};
+  SolidRunner direct(PETSC_COMM_WORLD, read_solid_scene(root), "");
+  for (int k = 1; k <= 2; ++k) {
+    direct.begin_step(k, 0.5 * k);
+    ASSERT_TRUE(direct.solve(pts, reply).converged);
+    direct.end_step(true);
+  }
+  SolidRunner coupled(PETSC_COMM_WORLD, read_solid_scene(root), "");
+  if (world_rank() == 0) {
+    MpiSolidParticipant leader(coupled, PETSC_COMM_WORLD);
+    for (int k = 1; k <= 2; ++k) {
+      leader.begin_step(k, 0.5 * k);
+      const auto st = leader.solve(pts, reply);
+      EXPECT_TRUE(st.converged);
+      EXPECT_EQ(reply.line_loads.size(), 2u);
+      leader.end_step(k == 2 ? true : true);
+    }
+    leader.shutdown();
+  } else {
+    EXPECT_EQ(run_follower(coupled, PETSC_COMM_WORLD), 0);
+  }
+  double d = 0;
+  for (size_t n = 0; n < direct.model().mesh().X.size(); ++n)
+    d = std::max(d, (direct.model().displacement(int(n)) - coupled.model().displacement(int(n))).norm());
+  EXPECT_LT(d, 1e-12);
+  EXPECT_EQ(coupled.history().size(), 3u);
+}
+
+// Bad input is reported with file and key path.
+TEST(Scene, ErrorsNameTheKey) {
+  const std::string scene_file = std::string(ANGIO_SOLID_TEST_DATA) + "/bad_material.yaml";
+  try {
+    read_solid_scene(angio::scene::load_scene(scene_file));
+    FAIL() << "expected SceneError";
+  } catch (const angio::scene::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("artery.layers.media.E"), std::string::npos) << e.what();
+  }
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  int fake_argc = 1;
+  PetscInitialize(&fake_argc, &argv, nullptr, nullptr);
+  if (world_rank() != 0) {
+    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+  }
+  const int rc = RUN_ALL_TESTS();
+  int any = 0;
+  MPI_Allreduce(&rc, &any, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
+  PetscFinalize();
+  return any;
+}
