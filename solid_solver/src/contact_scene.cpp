@@ -86,7 +86,7 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
     if (!log || m.rank() != 0) return;
     std::ostringstream os;
     os << std::setprecision(4) << "contact t=" << m.time();
-    if (stent_)
+    if (stent_ && stent_->num_points() > 0)
       os << " stent: " << reply.n_active << "/" << stent_->num_points() << " points active, min gap "
          << reply.min_gap << " mm, |sum w q| "
          << std::sqrt(reply.total_force[0] * reply.total_force[0] + reply.total_force[1] * reply.total_force[1] +

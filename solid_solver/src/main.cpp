@@ -16,6 +16,7 @@
 #include "angio/common/cli.hpp"
 #include "angio/common/log.hpp"
 #include "angio/participant/standalone.hpp"
+#include "angio/solid/contact_scene.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
 #ifdef ANGIO_SOLID_HAVE_SERVE
@@ -50,10 +51,12 @@ int main(int argc, char** argv) {
     }
     angio::solid::SolidScene scene;
     angio::scene::TimeSettings time_settings;
+    angio::solid::ContactSpec contact_spec;
     try {
       const auto root = angio::scene::load_scene(cli.get("scene"));
       scene = angio::solid::read_solid_scene(root);
       time_settings = scene.time;
+      contact_spec = angio::solid::read_contact_spec(root);
     } catch (const std::exception& e) {
       if (rank == 0) LOG_ERROR(e.what());
       PetscFinalize();
@@ -61,6 +64,7 @@ int main(int argc, char** argv) {
     }
     try {
       angio::solid::SolidRunner runner(PETSC_COMM_WORLD, std::move(scene), cli.get("run-dir"));
+      angio::solid::ContactSetup contact(runner, contact_spec);
       const std::string endpoint = cli.maybe("endpoint").value_or("");
       if (endpoint.empty()) {
         code = angio::participant::run_standalone(runner, time_settings);

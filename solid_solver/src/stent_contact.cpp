@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <stdexcept>
 
 #include "angio/solid/model.hpp"
@@ -45,26 +46,30 @@ void allow_new_nonzeros(Mat K) {
   if (K) ANGIO_CPETSC(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
 }
 
-void bcast_summary(ContactSummary& s, MPI_Comm comm) {
-  double b[7] = {double(s.num_points), double(s.num_active), s.min_gap, s.force, s.force_magnitude, s.energy, 0.0};
-  MPI_Bcast(b, 7, MPI_DOUBLE, 0, comm);
-  s.num_points = int(b[0]);
-  s.num_active = int(b[1]);
-  s.min_gap = b[2];
-  s.force = b[3];
-  s.force_magnitude = b[4];
-  s.energy = b[5];
+// Global diagnostics from the per-rank slices (sums, min gap), same on every rank.
+ContactSummary reduce_summary(const contact::ContactDiagnostics& d, double area, double radius, MPI_Comm comm,
+                              double* area_out) {
+  double sum[8] = {double(d.num_points), double(d.num_active), d.force_on_solid(0), d.force_on_solid(1),
+                   d.force_on_solid(2), d.force_magnitude, d.energy, area};
+  double g[8];
+  MPI_Allreduce(sum, g, 8, MPI_DOUBLE, MPI_SUM, comm);
+  double mn = d.min_gap, gmn;
+  MPI_Allreduce(&mn, &gmn, 1, MPI_DOUBLE, MPI_MIN, comm);
+  ContactSummary s;
+  s.num_points = int(g[0]);
+  s.num_active = int(g[1]);
+  s.force = std::sqrt(g[2] * g[2] + g[3] * g[3] + g[4] * g[4]);
+  s.force_magnitude = g[5];
+  s.energy = g[6];
+  s.min_gap = std::isfinite(gmn) ? gmn : radius;
+  if (area_out) *area_out = g[7];
+  return s;
 }
 
-ContactSummary summarize(const contact::ContactDiagnostics& d, double radius) {
-  ContactSummary s;
-  s.num_points = d.num_points;
-  s.num_active = d.num_active;
-  s.min_gap = std::isfinite(d.min_gap) ? d.min_gap : radius;
-  s.force = d.force_on_solid.norm();
-  s.force_magnitude = d.force_magnitude;
-  s.energy = d.energy;
-  return s;
+// Contiguous slice [lo, hi) of n items for this rank.
+void slice(std::size_t n, int rank, int size, std::size_t& lo, std::size_t& hi) {
+  lo = n * std::size_t(rank) / std::size_t(size);
+  hi = n * std::size_t(rank + 1) / std::size_t(size);
 }
 
 }  // namespace
@@ -150,16 +155,28 @@ void PenaltyStentContact::evaluate_(const SolidModel& model, bool tangent, Eval&
 void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   const double t0 = MPI_Wtime();
   allow_new_nonzeros(K);
-  ContactSummary s;
-  s.min_gap = opt_.search_radius;
-  if (model.rank() == 0 && !points_.empty() && !searches_.empty()) {
-    Eval e;
-    evaluate_(model, K != nullptr, e);
-    for (const auto& res : e.per_surface) insert(model, res.solid, r, K);
-    s = summarize(e.diag, opt_.search_radius);
+  // every rank holds all coordinates: each evaluates a contiguous slice of the points against the whole
+  // surfaces and adds its own contributions (each enters the global system exactly once)
+  contact::ContactDiagnostics diag;
+  if (!points_.empty() && !searches_.empty()) {
+    std::size_t lo, hi;
+    slice(points_.size(), model.rank(), model.size(), lo, hi);
+    if (hi > lo) {
+      gather_coords(model, coords_);
+      const std::span<const contact::BeamPoint> mine(points_.data() + lo, hi - lo);
+      for (size_t k = 0; k < searches_.size(); ++k) {
+        searches_[k]->update(coords_, /*rebuild=*/true);
+        const contact::SurfaceSearch* one[] = {searches_[k].get()};
+        contact::LineContactParams par;
+        par.penalty = penalty_[k];
+        par.compute_tangent = K != nullptr;
+        const auto res = contact::evaluate_line_contact(mine, one, par);
+        insert(model, res.solid, r, K);
+        diag.merge(res.diag);
+      }
+    }
   }
-  bcast_summary(s, model.comm());
-  last_ = s;
+  last_ = reduce_summary(diag, 0.0, opt_.search_radius, model.comm(), nullptr);
   timing_.calls++;
   timing_.seconds += MPI_Wtime() - t0;
 }
@@ -222,7 +239,13 @@ PenaltySurfaceContact::PenaltySurfaceContact(const SolidModel& model, Options op
   if (!(opt_.search_radius > 0)) throw std::runtime_error("surface contact: search radius must be positive");
   slave_ = std::make_unique<contact::Surface>(to_contact_surface(*s, +1.0));
   master_ = std::make_unique<contact::Surface>(to_contact_surface(*m, +1.0));
-  ss_ = std::make_unique<contact::SurfaceSearch>(*slave_, opt_.search_radius);
+  if (!opt_.two_pass) {
+    // one pass: the slave search is not used as a master, so each rank can own a slice of the slave faces
+    std::size_t lo, hi;
+    slice(slave_->faces.size(), model.rank(), model.size(), lo, hi);
+    slave_->faces = std::vector<contact::Face>(slave_->faces.begin() + lo, slave_->faces.begin() + hi);
+  }
+  if (!slave_->faces.empty()) ss_ = std::make_unique<contact::SurfaceSearch>(*slave_, opt_.search_radius);
   sm_ = std::make_unique<contact::SurfaceSearch>(*master_, opt_.search_radius);
   last_.min_gap = opt_.search_radius;
 }
@@ -232,10 +255,11 @@ PenaltySurfaceContact::~PenaltySurfaceContact() = default;
 void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
   const double t0 = MPI_Wtime();
   allow_new_nonzeros(K);
-  ContactSummary s;
-  s.min_gap = opt_.search_radius;
+  contact::ContactDiagnostics diag;
   double area = 0.0;
-  if (model.rank() == 0) {
+  // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything
+  const bool mine = opt_.two_pass ? model.rank() == 0 : ss_ != nullptr;
+  if (mine) {
     gather_coords(model, coords_);
     ss_->update(coords_);
     sm_->update(coords_);
@@ -246,13 +270,10 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
     par.compute_tangent = K != nullptr;
     const auto res = contact::evaluate_surface_contact(*ss_, *sm_, par);
     insert(model, res.contributions, r, K);
-    s = summarize(res.diag, opt_.search_radius);
+    diag = res.diag;
     area = res.active_area;
   }
-  bcast_summary(s, model.comm());
-  MPI_Bcast(&area, 1, MPI_DOUBLE, 0, model.comm());
-  last_ = s;
-  active_area_ = area;
+  last_ = reduce_summary(diag, area, opt_.search_radius, model.comm(), &active_area_);
   timing_.calls++;
   timing_.seconds += MPI_Wtime() - t0;
 }

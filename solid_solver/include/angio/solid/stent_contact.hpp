@@ -9,10 +9,12 @@
 //  * CompositeContact: the StentContact registered with SolidRunner (SolidModel holds one ContactModel
 //    pointer); forwards add() to both and the reply to the stent part.
 //
-// MPI: every rank holds the full displacement, so the searches are built over the whole surfaces on rank 0;
-// rank 0 evaluates and adds the residual/tangent (ADD_VALUES, communicated by the model's assembly), the other
-// ranks add nothing, so every contribution enters the global system exactly once. add() is collective (it
-// broadcasts the diagnostics); fill_reply() evaluates on every rank (identical data, no communication).
+// MPI: every rank holds the full displacement, so every rank builds the searches over the WHOLE surfaces (no
+// artificial free edges at partition boundaries) and evaluates a contiguous slice of the beam points / of the
+// slave faces (two_pass: rank 0 evaluates everything); each rank adds its own contributions (ADD_VALUES,
+// communicated by the model's assembly), so every contribution enters the global system exactly once.
+// add() is collective (Allreduce of the diagnostics); fill_reply() evaluates all points on every rank
+// (identical data, no communication).
 // Units: mm, N, MPa.
 #pragma once
 #include <functional>

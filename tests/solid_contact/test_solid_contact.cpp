@@ -1,0 +1,442 @@
+// Contact wired into the solid solver (solid_solver/src/stent_contact.cpp, contact_scene.cpp).
+// Run under mpirun with 1 and 2 ranks.
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <petscsys.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <random>
+
+#include "angio/scene/node.hpp"
+#include "angio/solid/contact_scene.hpp"
+#include "angio/solid/model.hpp"
+#include "angio/solid/participant.hpp"
+#include "angio/solid/scene.hpp"
+#include "angio/solid/stent_contact.hpp"
+
+using namespace angio::solid;
+namespace participant = angio::participant;
+
+namespace {
+
+int world_rank() {
+  int r;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &r);
+  return r;
+}
+int world_size() {
+  int s;
+  MPI_Comm_size(PETSC_COMM_WORLD, &s);
+  return s;
+}
+
+Mesh tube(const std::string& part, double inner_radius, double wall, double length, int n_circ, int n_axial,
+          int n_radial = 1) {
+  TubeSpec t;
+  t.part = part;
+  t.surface_prefix = part + "_";
+  t.length = length;
+  t.inner_radius = inner_radius;
+  t.layers = {{part, wall, n_radial}};
+  t.n_circ = n_circ;
+  t.n_axial = n_axial;
+  return make_tube(t);
+}
+
+ModelOptions tight_options() {
+  ModelOptions o;
+  o.petsc_options = "-ksp_rtol 1e-13 -ksp_atol 1e-16";
+  o.newton.rtol = 1e-11;
+  o.newton.atol = 1e-12;
+  return o;
+}
+
+LayerMaterial neo_hooke(const std::string& name, double E, double nu) { return LayerMaterial{name, {E, nu}, {}}; }
+
+// Sum of a distributed vector per component (dofs are interlaced: global dof % 3 = component).
+std::array<double, 3> component_sums(Vec v) {
+  PetscInt lo, hi;
+  VecGetOwnershipRange(v, &lo, &hi);
+  const PetscScalar* a;
+  VecGetArrayRead(v, &a);
+  std::array<double, 3> loc{0, 0, 0}, glob{};
+  for (PetscInt i = lo; i < hi; ++i) loc[i % 3] += a[i - lo];
+  VecRestoreArrayRead(v, &a);
+  MPI_Allreduce(loc.data(), glob.data(), 3, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  return glob;
+}
+
+// Whole vector on every rank (global dof order).
+std::vector<double> gather_all(Vec v) {
+  VecScatter sc;
+  Vec all;
+  VecScatterCreateToAll(v, &sc, &all);
+  VecScatterBegin(sc, v, all, INSERT_VALUES, SCATTER_FORWARD);
+  VecScatterEnd(sc, v, all, INSERT_VALUES, SCATTER_FORWARD);
+  PetscInt n;
+  VecGetSize(all, &n);
+  const PetscScalar* a;
+  VecGetArrayRead(all, &a);
+  std::vector<double> out(a, a + n);
+  VecRestoreArrayRead(all, &a);
+  VecScatterDestroy(&sc);
+  VecDestroy(&all);
+  return out;
+}
+
+// A point at distance (R - depth) from the centre of face f along its outward normal: penetration `depth`.
+participant::Vec3 pressed_point(const Mesh& m, const Face& f, double R, double depth, Vec3d* normal = nullptr) {
+  Vec3d c = Vec3d::Zero();
+  for (int a = 0; a < 4; ++a) c += m.X[f.n[a]] / 4.0;
+  Vec3d n = (m.X[f.n[2]] - m.X[f.n[0]]).cross(m.X[f.n[3]] - m.X[f.n[1]]).normalized();
+  if (normal) *normal = n;
+  const Vec3d x = c + (R - depth) * n;
+  return {x(0), x(1), x(2)};
+}
+
+}  // namespace
+
+// (1) One beam point pressed into a balloon-like tube, through SolidModel::assemble (the model's own r and K):
+// compared with (a) the reply's line loads: applied force on the solid (-sum r) = -sum w q (global force
+// balance, round-off), and (b) the closed form eps * penetration * w for a point over the centre of a flat
+// (planar) quad face with the normal along the face normal.
+TEST(StentContact, SinglePointForceBalance) {
+  Mesh m = tube("balloon", 0.45, 0.04, 2.0, 16, 6);
+  const Face f = m.surface("balloon_outer")->faces[37];
+  const double R = 0.06, depth = 0.004, w = 0.05, eps = 10.0;
+  Vec3d n;
+  participant::SamplePoints pts;
+  pts.x = {pressed_point(m, f, R, depth, &n)};
+  pts.w = {w};
+  pts.radius = {R};
+  SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 17.0, 0.0)}, tight_options());
+  PenaltyStentContact::Options o;
+  o.balloon_penalty = eps;
+  PenaltyStentContact contact(model, o);
+  ASSERT_EQ(contact.num_surfaces(), 1);
+  model.set_contact(&contact);
+  contact.set_points(pts);
+  ASSERT_TRUE(model.assemble(model.residual_vector(), model.matrix()));  // u = 0: only contact contributes
+  const auto rsum = component_sums(model.residual_vector());
+  participant::ContactReply reply;
+  reset_reply(pts, reply);
+  contact.fill_reply(model, reply);
+  EXPECT_EQ(reply.n_active, 1);
+  EXPECT_EQ(reply.active[0], 1);
+  EXPECT_NEAR(reply.min_gap, -depth, 1e-12);
+  EXPECT_DOUBLE_EQ(reply.penalty[0], eps);
+  for (int c = 0; c < 3; ++c) {
+    // force on the solid = -sum r = -sum w q  <=>  sum r = sum w q
+    EXPECT_NEAR(rsum[c], reply.total_force[c], 1e-14) << c;
+    EXPECT_NEAR(reply.total_force[c], eps * depth * w * n(c), 1e-12) << c;
+    EXPECT_NEAR(reply.line_loads[0][c], eps * depth * n(c), 1e-10) << c;
+    EXPECT_NEAR(reply.normals[0][c], n(c), 1e-10) << c;
+  }
+  EXPECT_EQ(contact.last().num_active, 1);
+  EXPECT_NEAR(contact.last().min_gap, -depth, 1e-12);
+  EXPECT_NEAR(contact.last().force, eps * depth * w, 1e-12);
+}
+
+// (1b) The same through SolidRunner and the scene's contact: section: a ring of beam points pressing the balloon
+// inward is solved to equilibrium; at the converged state the contact residual (added into a fresh vector)
+// balances the reply's sum w q (force balance), and the balloon moves inward under the points.
+TEST(StentContact, RunnerRingOfPointsConverges) {
+  const char* yaml = R"(
+time: {end: 1.0, steps: 1}
+balloon:
+  mesh: {generator: tube, length: 2.0, outer_diameter: 0.98, wall: 0.04, n_circ: 16, n_axial: 8}
+  material: {E: 17.0, nu: 0.0}
+  end_springs: 1.0e3
+contact:
+  stent_balloon: {penalty: 10.0}
+  search_radius: 0.3
+  log: false
+solid:
+  petsc_options: "-ksp_rtol 1e-12"
+  newton: {rtol: 1.0e-10, atol: 1.0e-12}
+)";
+  const angio::scene::Node root(YAML::Load(yaml), "inline.yaml", "");
+  SolidRunner runner(PETSC_COMM_WORLD, read_solid_scene(root), "");
+  auto setup = make_contact(root, runner);
+  ASSERT_NE(setup->stent(), nullptr);
+  EXPECT_EQ(setup->balloon_artery(), nullptr);
+  participant::SamplePoints pts;
+  const double R = 0.06, r_beam = 0.49 + R - 0.03;  // 0.03 mm initial penetration at the nodal radius
+  for (int i = 0; i < 24; ++i) {
+    const double a = 2 * M_PI * (i + 0.3) / 24;
+    pts.x.push_back({r_beam * std::cos(a), r_beam * std::sin(a), 0.13});
+    pts.w.push_back(0.1);
+    pts.radius.push_back(R);
+  }
+  participant::ContactReply reply;
+  runner.begin_step(1, 1.0);
+  const auto st = runner.solve(pts, reply);
+  ASSERT_TRUE(st.converged) << st.message;
+  EXPECT_EQ(reply.n_active, 24);
+  EXPECT_LT(reply.min_gap, 0.0);
+  EXPECT_GT(reply.min_gap, -0.03);  // the balloon gave way
+  double qn = 0;
+  for (const auto& q : reply.line_loads) qn += std::hypot(q[0], q[1]);
+  EXPECT_GT(qn, 0.0);
+  Vec r;
+  VecDuplicate(runner.model().residual_vector(), &r);
+  VecSet(r, 0.0);
+  setup->stent()->add(runner.model(), r, nullptr);
+  VecAssemblyBegin(r);
+  VecAssemblyEnd(r);
+  const auto rs = component_sums(r);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(rs[c], reply.total_force[c], 1e-13) << c;
+  VecDestroy(&r);
+  runner.end_step(true);
+}
+
+// (2) The assembled tangent of the model (elements + stent line contact + balloon-artery surface contact, through
+// ContactModel::add into the model's PETSc Mat, including the new balloon-artery couplings) compared with
+// central finite differences of the assembled residual.
+TEST(StentContact, TangentMatchesFiniteDifferences) {
+  Mesh m = tube("balloon", 0.44, 0.04, 1.2, 10, 3);
+  m.append(tube("artery", 0.47, 0.1, 1.6, 8, 3));  // balloon outer radius 0.48 > artery inner radius 0.47
+  SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 1.0, 0.3), neo_hooke("artery", 0.5, 0.3)},
+                   tight_options());
+  participant::SamplePoints pts;
+  const auto& faces = model.mesh().surface("balloon_outer")->faces;
+  for (int k : {3, 14, 22}) {
+    pts.x.push_back(pressed_point(model.mesh(), faces[k], 0.06, 0.005));
+    pts.w.push_back(0.07);
+    pts.radius.push_back(0.06);
+  }
+  PenaltyStentContact::Options so;
+  so.balloon_penalty = 10.0;
+  so.artery_penalty = 8.0;
+  PenaltyStentContact stent(model, so);
+  PenaltySurfaceContact::Options bo;
+  bo.penalty = 5.0;
+  PenaltySurfaceContact ba(model, bo);
+  CompositeContact comp;
+  comp.set_stent(&stent);
+  comp.add_model(&ba);
+  model.set_contact(&comp);
+  comp.set_points(pts);
+  // a small generic displacement state (same on all ranks)
+  const int nn = int(model.mesh().X.size());
+  std::vector<Vec3d> u0(nn);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1e-3, 1e-3);
+  for (auto& v : u0) v = Vec3d(U(rng), U(rng), U(rng));
+  model.set_displacement(u0);
+  ASSERT_TRUE(model.assemble(model.residual_vector(), model.matrix()));
+  EXPECT_GT(stent.last().num_active, 3);  // points touch balloon and artery
+  EXPECT_GT(ba.last().num_active, 0);
+  Mat K = model.matrix();
+  PetscInt lo, hi;
+  MatGetOwnershipRange(K, &lo, &hi);
+  Vec r;
+  VecDuplicate(model.residual_vector(), &r);
+  const double h = 1e-6;
+  double max_err = 0, max_k = 0, max_cross = 0;
+  std::vector<PetscInt> rows;
+  for (PetscInt i = lo; i < hi; ++i) rows.push_back(i);
+  std::vector<double> kcol(rows.size());
+  for (int j = 0; j < 3 * nn; ++j) {
+    const int node = model.old_index(j / 3), c = j % 3;
+    std::vector<Vec3d> up = u0, um = u0;
+    up[node](c) += h;
+    um[node](c) -= h;
+    model.set_displacement(up);
+    model.assemble(r, nullptr);
+    const auto rp = gather_all(r);
+    model.set_displacement(um);
+    model.assemble(r, nullptr);
+    const auto rm = gather_all(r);
+    PetscInt col = j;
+    if (!rows.empty()) MatGetValues(K, PetscInt(rows.size()), rows.data(), 1, &col, kcol.data());
+    for (size_t a = 0; a < rows.size(); ++a) {
+      const double fd = (rp[rows[a]] - rm[rows[a]]) / (2 * h);
+      max_err = std::max(max_err, std::abs(fd - kcol[a]));
+      max_k = std::max(max_k, std::abs(kcol[a]));
+    }
+  }
+  // cross-body coupling entries must exist: balloon nodes come first in the appended mesh
+  const int nb = int(tube("balloon", 0.44, 0.04, 1.2, 10, 3).X.size());
+  for (size_t a = 0; a < rows.size(); ++a) {
+    const bool row_balloon = model.old_index(int(rows[a] / 3)) < nb;
+    for (int j = 0; j < 3 * nn; ++j) {
+      const bool col_balloon = model.old_index(j / 3) < nb;
+      if (row_balloon == col_balloon) continue;
+      PetscInt col = j, row = rows[a];
+      double v = 0;
+      MatGetValues(K, 1, &row, 1, &col, &v);
+      max_cross = std::max(max_cross, std::abs(v));
+    }
+  }
+  double g[3] = {max_err, max_k, max_cross}, gg[3];
+  MPI_Allreduce(g, gg, 3, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
+  if (world_rank() == 0) std::printf("  tangent: max |K - K_fd| = %.3e, max |K| = %.3e, max |K_cross| = %.3e\n", gg[0], gg[1], gg[2]);
+  EXPECT_LT(gg[0], 1e-6 * gg[1]);
+  EXPECT_GT(gg[2], 1e-3 * gg[1]);
+  VecDestroy(&r);
+}
+
+// Cost of the stent contact in an assembly (printed): 1260 sample points (4-ring stent: 210 elements x 6) on a
+// helix pressing 2 um into the paper's balloon (22 x 58 hex8); compared with the whole assembly (elements +
+// contact) of the same model. No physical reference; checks that every point is active and the forces balance.
+TEST(StentContact, CostOfManyPoints) {
+  Mesh m = tube("balloon", 0.45, 0.04, 9.4, 22, 58);
+  SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 17.0, 0.0)}, tight_options());
+  PenaltyStentContact::Options o;
+  o.balloon_penalty = 10.0;
+  PenaltyStentContact contact(model, o);
+  model.set_contact(&contact);
+  participant::SamplePoints pts;
+  const int n = 1260;
+  const double R = 0.06, rb = 0.49 * std::cos(M_PI / 22) + R - 0.002;  // 2 um into the facets
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * 7.3 * i / n, z = -3.0 + 6.0 * i / n;
+    pts.x.push_back({rb * std::cos(a), rb * std::sin(a), z});
+    pts.w.push_back(0.02);
+    pts.radius.push_back(R);
+  }
+  contact.set_points(pts);
+  const int reps = 3;
+  const double t0 = MPI_Wtime();
+  for (int k = 0; k < reps; ++k) ASSERT_TRUE(model.assemble(model.residual_vector(), model.matrix()));
+  const double t_asm = (MPI_Wtime() - t0) / reps;
+  const double t_contact = contact.timing().seconds / double(contact.timing().calls);
+  if (world_rank() == 0)
+    std::printf("  %d points: contact add() %.2f ms per assembly (search + evaluation + insertion), whole assembly "
+                "%.2f ms (%.0f %%); %d active\n",
+                n, 1e3 * t_contact, 1e3 * t_asm, 100.0 * t_contact / t_asm, contact.last().num_active);
+  EXPECT_EQ(contact.last().num_active, n);
+  participant::ContactReply reply;
+  reset_reply(pts, reply);
+  contact.fill_reply(model, reply);
+  const auto rsum = component_sums(model.residual_vector());
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(rsum[c], reply.total_force[c], 1e-12) << c;
+}
+
+// (3) Balloon-artery: a pressurized inner tube presses on an outer tube (non-matching meshes). The load steps
+// converge, the tubes come into contact, and max displacement / contact force are the same on 1 and on 2 MPI
+// ranks (on 2 ranks, rank 0 also solves the same problem alone on PETSC_COMM_SELF and compares).
+namespace {
+struct BAResult {
+  bool converged = true;
+  double max_u = 0, force = 0, force_magnitude = 0, min_gap = 0, area = 0;
+  int active = 0;
+};
+BAResult balloon_artery_run(MPI_Comm comm) {
+  Mesh m = tube("balloon", 0.46, 0.04, 2.0, 16, 8);
+  m.append(tube("artery", 0.55, 0.2, 2.6, 12, 7));
+  ModelOptions o = tight_options();
+  o.newton.rtol = 1e-10;
+  o.newton.atol = 1e-11;
+  SolidModel model(comm, m, {neo_hooke("balloon", 1.0, 0.3), neo_hooke("artery", 0.1, 0.3)}, o);
+  model.add_pressure({"balloon_inner", [](double t) { return 0.03 * t; }});
+  for (const char* s : {"balloon_end0", "balloon_end1", "artery_end0", "artery_end1"}) model.add_springs({s, 10.0});
+  PenaltySurfaceContact::Options bo;
+  bo.penalty = 50.0;
+  bo.search_radius = 0.2;
+  PenaltySurfaceContact ba(model, bo);
+  model.set_contact(&ba);
+  BAResult res;
+  for (int step = 1; step <= 4; ++step) {
+    model.set_time(0.25 * step);
+    const auto rep = model.solve();
+    if (!rep.converged) {
+      res.converged = false;
+      return res;
+    }
+    model.commit();
+  }
+  for (size_t i = 0; i < model.mesh().X.size(); ++i) res.max_u = std::max(res.max_u, model.displacement(int(i)).norm());
+  res.force = ba.last().force;
+  res.force_magnitude = ba.last().force_magnitude;
+  res.min_gap = ba.last().min_gap;
+  res.active = ba.last().num_active;
+  res.area = ba.active_area();
+  return res;
+}
+}  // namespace
+
+TEST(BalloonArtery, ConvergesAndMatchesOnOneAndTwoRanks) {
+  const BAResult a = balloon_artery_run(PETSC_COMM_WORLD);
+  ASSERT_TRUE(a.converged);
+  if (world_rank() == 0)
+    std::printf("  balloon-artery (%d ranks): max|u| = %.9f mm, active %d, min gap %.3e mm, sum|f| = %.9f N, area %.4f\n",
+                world_size(), a.max_u, a.active, a.min_gap, a.force_magnitude, a.area);
+  EXPECT_GT(a.active, 0);
+  EXPECT_LT(a.min_gap, 0.0);
+  EXPECT_GT(a.max_u, 0.05);  // the 0.05 mm radial gap closed
+  EXPECT_LT(a.force, 1e-6 * a.force_magnitude + 1e-12);  // axisymmetric: net force on the artery ~ 0
+  if (world_size() > 1) {
+    BAResult b;
+    if (world_rank() == 0) b = balloon_artery_run(PETSC_COMM_SELF);
+    double v[4] = {b.max_u, b.force_magnitude, b.min_gap, double(b.active)};
+    MPI_Bcast(v, 4, MPI_DOUBLE, 0, PETSC_COMM_WORLD);
+    if (world_rank() == 0) std::printf("  balloon-artery (1 rank): max|u| = %.9f mm, sum|f| = %.9f N\n", v[0], v[1]);
+    EXPECT_NEAR(a.max_u, v[0], 1e-7 * v[0]);
+    EXPECT_NEAR(a.force_magnitude, v[1], 1e-6 * v[1]);
+    EXPECT_NEAR(a.min_gap, v[2], 1e-6 * std::abs(v[2]));
+    EXPECT_EQ(a.active, int(v[3]));
+  }
+}
+
+// Scene section validation: defaults, `off`, typos named with their key path.
+TEST(ContactScene, ReadsAndValidates) {
+  auto node = [](const char* y) { return angio::scene::Node(YAML::Load(y), "s.yaml", ""); };
+  {
+    const auto s = read_contact_spec(node("time: {end: 1}"));
+    EXPECT_EQ(*s.stent_balloon, 10.0);
+    EXPECT_EQ(*s.stent_artery, 10.0);
+    ASSERT_TRUE(s.balloon_artery);
+    EXPECT_EQ(s.balloon_artery->penalty, 5.0);
+  }
+  {
+    const auto s = read_contact_spec(node(
+        "contact: {stent_balloon: {penalty: 20}, stent_artery: off, balloon_artery: {penalty: 7, quadrature: 5}, "
+        "search_radius: 0.2}"));
+    EXPECT_EQ(*s.stent_balloon, 20.0);
+    EXPECT_FALSE(s.stent_artery);
+    EXPECT_EQ(s.balloon_artery->penalty, 7.0);
+    EXPECT_EQ(s.balloon_artery->quadrature, 5);
+    EXPECT_EQ(s.balloon_artery->search_radius, 0.2);
+    EXPECT_EQ(s.search_radius, 0.2);
+  }
+  auto error = [&](const char* y) {
+    try {
+      read_contact_spec(node(y));
+    } catch (const angio::scene::SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("contact: {stent_balon: {penalty: 1}}").find("contact.stent_balon"), std::string::npos);
+  EXPECT_NE(error("contact: {stent_balloon: {penalty: -1}}").find("contact.stent_balloon.penalty"), std::string::npos);
+  EXPECT_NE(error("contact: {balloon_artery: {penalti: 1}}").find("contact.balloon_artery.penalti"), std::string::npos);
+  EXPECT_NE(error("contact: {search_radius: 0}").find("contact.search_radius"), std::string::npos);
+  EXPECT_NE(error("contact: {stent_artery: maybe}").find("contact.stent_artery"), std::string::npos);
+}
+
+// The shipped scene parses (solid parts + contact section) and enables balloon-artery contact.
+TEST(ContactScene, ShippedBalloonInArteryScene) {
+  const auto root = angio::scene::load_scene(std::string(ANGIO_CONFIGS_DIR) + "/solid_balloon_in_artery.yaml");
+  const SolidScene sc = read_solid_scene(root);
+  EXPECT_TRUE(sc.has_balloon && sc.has_artery);
+  const ContactSpec spec = read_contact_spec(root);
+  ASSERT_TRUE(spec.balloon_artery);
+  EXPECT_EQ(spec.balloon_artery->penalty, 50.0);
+  EXPECT_EQ(*spec.stent_balloon, 10.0);
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  int fake_argc = 1;
+  PetscInitialize(&fake_argc, &argv, nullptr, nullptr);
+  if (world_rank() != 0) {
+    auto& l = ::testing::UnitTest::GetInstance()->listeners();
+    delete l.Release(l.default_result_printer());
+  }
+  const int rc = RUN_ALL_TESTS();
+  PetscFinalize();
+  return rc;
+}
