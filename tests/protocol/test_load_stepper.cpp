@@ -2,6 +2,8 @@
 // and gives up below the minimum increment with the reason (consistency properties).
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "angio/common/load_stepper.hpp"
 
 using angio::LoadStepper;
@@ -23,23 +25,32 @@ TEST(LoadStepper, NominalSteps) {
   EXPECT_NEAR(st.previous_time(), 2.0, 1e-12);
 }
 
-TEST(LoadStepper, CutsAndRecovers) {
+TEST(LoadStepper, CutsAndRecoversOnTheNominalGrid) {
   angio::scene::TimeSettings s;
   s.end = 1.0;
   s.steps = 4;
   s.min_step = 0.01;
   LoadStepper st(s);
+  st.accept();  // t = 0.25
   st.reject("test");
   EXPECT_DOUBLE_EQ(st.increment(), 0.125);
-  EXPECT_DOUBLE_EQ(st.time(), 0.125);
+  EXPECT_DOUBLE_EQ(st.time(), 0.375);
+  st.reject("test");
+  EXPECT_DOUBLE_EQ(st.time(), 0.3125);
   st.accept();
-  EXPECT_DOUBLE_EQ(st.increment(), 0.25);  // grows back to nominal
-  double t = st.previous_time();
+  // Grows back (0.125) but does not cross the grid point 0.5 ...
+  EXPECT_DOUBLE_EQ(st.time(), 0.4375);
+  st.accept();
+  EXPECT_DOUBLE_EQ(st.time(), 0.5);
+  st.accept();
+  // ... keeps doubling from the grid point until it is nominal again.
+  EXPECT_DOUBLE_EQ(st.increment(), 0.125);
+  std::vector<double> times;
   while (!st.finished()) {
-    t = st.time();
+    times.push_back(st.time());
     st.accept();
   }
-  EXPECT_DOUBLE_EQ(t, 1.0);  // the last step lands exactly on the end time
+  EXPECT_EQ(times, (std::vector<double>{0.625, 0.75, 1.0}));  // the grid and the end exactly
 }
 
 TEST(LoadStepper, GivesUpBelowMinimumWithReason) {

@@ -8,12 +8,16 @@ namespace angio {
 
 LoadStepper::LoadStepper(const scene::TimeSettings& s)
     : s_(s), nominal_((s.end - s.start) / s.steps), t_(s.start), dt_(nominal_) {
-  clamp_to_end();
+  clamp_to_grid();
 }
 
-// Lands exactly on the end time instead of leaving a sliver step.
-void LoadStepper::clamp_to_end() {
-  const double rest = s_.end - t_;
+// Never steps across a point of the nominal grid (start + k·Δt_nominal): after a cut the
+// increments grow back but still land on the grid, so the corners of the load curves (the peak
+// pressure at t = 1 s) are hit exactly. Also lands exactly on the end time.
+void LoadStepper::clamp_to_grid() {
+  const double k = std::floor((t_ - s_.start) / nominal_ + 1e-9) + 1.0;
+  const double next_grid = std::min(s_.start + k * nominal_, s_.end);
+  const double rest = next_grid - t_;
   if (dt_ > rest || rest - dt_ < 1e-9 * nominal_) dt_ = rest;
 }
 
@@ -24,7 +28,7 @@ void LoadStepper::accept() {
   ++step_;
   cuts_ = 0;
   dt_ = std::min(2.0 * dt_, nominal_);
-  clamp_to_end();
+  clamp_to_grid();
 }
 
 void LoadStepper::reject(const std::string& reason) {

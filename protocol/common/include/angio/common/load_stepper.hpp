@@ -1,7 +1,8 @@
 // Pseudo-time load stepping with step cutting, shared by the coupler and the standalone solvers.
 //
 // A step that fails (no Newton or coupling convergence) is retried with half the increment; after
-// a success the increment grows back (doubling) toward the nominal one. Below the minimum
+// a success the increment grows back (doubling) toward the nominal one, never stepping across a
+// point of the nominal grid, so load-curve corners are hit exactly. Below the minimum
 // increment the stepper gives up with an error naming the time and the increment.
 #pragma once
 
@@ -33,7 +34,7 @@ class LoadStepper {
   void reject(const std::string& reason);
 
  private:
-  void clamp_to_end();
+  void clamp_to_grid();
   scene::TimeSettings s_;
   double nominal_;
   double t_;
