@@ -64,8 +64,7 @@ int main(int argc, char** argv) {
     if (!args.parse(argc, argv)) return 0;
     cli::setup_logging(args, "replay-driver");
     const std::string role = args.get("role");
-    const fb::Role r = role == "beam" ? fb::Role::Beam : role == "solid" ? fb::Role::Solid
-                       : throw cli::UsageError("--role: expected beam or solid, got '" + role + "'");
+    const fb::Role r = replay::role_from_name(role);
     const auto rec = recording::read(args.get("recording"));
     const double tol = args.number("tolerance");
     const auto timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
@@ -94,6 +93,9 @@ int main(int argc, char** argv) {
                << worst << " (tolerance " << tol << ")");
     return 0;
   } catch (const cli::UsageError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
     LOG_ERROR(e.what());
     return 2;
   } catch (const std::exception& e) {

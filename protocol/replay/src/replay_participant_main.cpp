@@ -21,20 +21,22 @@ int main(int argc, char** argv) {
     if (!args.parse(argc, argv)) return 0;
     const std::string role = args.get("role");
     cli::setup_logging(args, "replay-" + role);
-    if (role != "beam" && role != "solid")
-      throw cli::UsageError("--role: expected beam or solid, got '" + role + "'");
+    const fb::Role r = replay::role_from_name(role);
     const auto rec = recording::read(args.get("recording"));
     participant::ServeOptions o =
         participant::serve_options(args, "replay_participant (" + args.get("recording") + ")");
     if (!args.has("run-id")) o.run_id = rec.run_id;
     const double tol = args.number("tolerance");
-    if (role == "beam") {
+    if (r == fb::Role::Beam) {
       replay::ReplayBeam beam(rec, tol);
       return participant::serve(beam, o);
     }
     replay::ReplaySolid solid(rec, tol);
     return participant::serve(solid, o);
   } catch (const cli::UsageError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
     LOG_ERROR(e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -8,6 +8,12 @@
 
 namespace angio::replay {
 
+fb::Role role_from_name(const std::string& name) {
+  if (name == "beam") return fb::Role::Beam;
+  if (name == "solid") return fb::Role::Solid;
+  throw std::invalid_argument("--role: expected beam or solid, got '" + name + "'");
+}
+
 Cursor::Cursor(const recording::Recording& rec, fb::Role role) : run_id_(rec.run_id), role_(role) {
   for (const auto& e : rec.exchanges)
     if (e.role == role) items_.push_back(&e);

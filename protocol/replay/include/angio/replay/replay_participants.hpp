@@ -20,6 +20,9 @@ class ReplayMismatch : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// "beam" → Role::Beam, "solid" → Role::Solid; anything else throws std::invalid_argument.
+fb::Role role_from_name(const std::string& name);
+
 // Walks through the recorded exchanges of one role in order.
 class Cursor {
  public:
