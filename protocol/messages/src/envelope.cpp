@@ -4,6 +4,14 @@ namespace angio::msg {
 
 const char* role_name(fb::Role r) { return fb::EnumNameRole(r); }
 
+const char* role_key(fb::Role r) {
+  switch (r) {
+    case fb::Role::Beam: return "beam";
+    case fb::Role::Solid: return "solid";
+    default: return "coupler";
+  }
+}
+
 const char* payload_name(fb::Payload p) {
   const char* n = fb::EnumNamePayload(p);
   return (n && *n) ? n : "unknown payload";

@@ -11,13 +11,6 @@ namespace angio::participant {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-std::string lower_role(fb::Role r) {
-  switch (r) {
-    case fb::Role::Beam: return "beam";
-    case fb::Role::Solid: return "solid";
-    default: return "coupler";
-  }
-}
 }  // namespace
 
 Channel::Channel(const transport::Session& session, std::string run_id, fb::Role role,
@@ -25,7 +18,7 @@ Channel::Channel(const transport::Session& session, std::string run_id, fb::Role
     : session_(session),
       run_id_(std::move(run_id)),
       role_(role),
-      role_name_(lower_role(role)),
+      role_name_(msg::role_key(role)),
       timeout_(timeout),
       recorder_(recorder) {}
 

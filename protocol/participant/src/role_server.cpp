@@ -25,7 +25,7 @@ double seconds_since(Clock::time_point t0) {
 // coupler's liveliness token and the silence timeout so that a vanished coupler ends the process
 // with a clear error instead of a hang.
 int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
-  const std::string name = fb::EnumNameRole(role) == std::string("Beam") ? "beam" : "solid";
+  const std::string name = msg::role_key(role);
   std::optional<transport::Session> session;
   try {
     session.emplace(transport::Session::open({{}, {o.endpoint}}));

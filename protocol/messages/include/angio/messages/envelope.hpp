@@ -24,7 +24,8 @@ class ProtocolError : public std::runtime_error {
 
 using Buffer = std::vector<std::uint8_t>;
 
-const char* role_name(fb::Role r);
+const char* role_name(fb::Role r);  // "Coupler", "Beam", "Solid"
+const char* role_key(fb::Role r);   // "coupler", "beam", "solid": the role in key expressions
 const char* payload_name(fb::Payload p);
 
 // Verifies `bytes` and returns the envelope inside (pointing into `bytes`). Throws ProtocolError
