@@ -61,22 +61,12 @@ void AabbTree::refit(const std::vector<Aabb>& boxes) {
   }
 }
 
+// A point query is a box query with a degenerate box (overlaps == contains for lo == hi == p).
 void AabbTree::query(const Vec3& p, std::vector<int>& out) const {
-  if (nodes_.empty()) return;
-  int stack[128];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& nd = nodes_[stack[--top]];
-    if (!nd.box.contains(p)) continue;
-    if (nd.left < 0) {
-      for (int k = nd.begin; k < nd.end; ++k)
-        if (boxes_[items_[k]].contains(p)) out.push_back(items_[k]);
-    } else {
-      stack[top++] = nd.left;
-      stack[top++] = nd.right;
-    }
-  }
+  Aabb b;
+  b.lo = p;
+  b.hi = p;
+  query(b, out);
 }
 
 void AabbTree::query(const Aabb& b, std::vector<int>& out) const {
