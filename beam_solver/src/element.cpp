@@ -57,21 +57,16 @@ void rotate_transpose(const Q<T>& q, const T* v, T* out) {
   out[2] = v[2] + 2.0 * (q.w * cz) + 2.0 * ccz;
 }
 
-// Strain (Γ, Ω) without the reference subtraction, for perturbations p (12 variables, order
-// x1, θ1, x2, θ2) applied as x + p, Λ = (I + ½ p̂θ...) Λ; pe and pd are two sets combined as
-// exp(pe) exp(pd) Λ.
+// Relative rotation of the two element triads (Crisfield–Jelenić): φ = log(Λ1ᵀΛ2) (in the Λ1
+// frame) and the reference triad Λ_r = Λ1 exp(φ/2), with sqrt(q) = normalize(1 + q) for the
+// shortest-arc quaternion. Shared by the strain and the rotation kernels.
 template <class T>
-void strains_raw(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
-                 const Quat& R2, const T* pe, const T* pd, T* S, Q<T>* qr_out = nullptr) {
+void relative_rotation(const Q<T>& L1, const Q<T>& L2, T* phi, Q<T>& qr) {
   using std::sqrt;
   using std::atan2;
-  Q<T> L1 = qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R1 * ref.O1));
-  Q<T> L2 = qmul(qmul(qsmall(pe + 9), qsmall(pd + 9)), qconst<T>(R2 * ref.O2));
-  L1 = qnormalize(L1);
-  L2 = qnormalize(L2);
   Q<T> rel = qmul(qconj(L1), L2);
   if (val(rel.w) < 0.0) rel = {-rel.w, -rel.x, -rel.y, -rel.z};
-  // φ = log(rel) = 2 atan2(|v|, w) v/|v|
+  // φ = log(rel) = 2 atan2(|v|, w) v/|v| (series for small |v| keeps the derivatives finite)
   T s = rel.x * rel.x + rel.y * rel.y + rel.z * rel.z;
   T f;
   const double sv = val(s), wv = val(rel.w);
@@ -82,13 +77,29 @@ void strains_raw(const ElementReference& ref, const Vec3& x1, const Vec3& x2, co
     T nv = sqrt(s);
     f = atan2(nv, rel.w) / nv;
   }
+  phi[0] = 2.0 * f * rel.x;
+  phi[1] = 2.0 * f * rel.y;
+  phi[2] = 2.0 * f * rel.z;
+  qr = qmul(L1, qnormalize(Q<T>{rel.w + 1.0, rel.x, rel.y, rel.z}));
+}
+
+// Strain (Γ, Ω) without the reference subtraction, for perturbations p (12 variables, order
+// x1, θ1, x2, θ2) applied as x + p, Λ = (I + ½ p̂θ...) Λ; pe and pd are two sets combined as
+// exp(pe) exp(pd) Λ.
+template <class T>
+void strains_raw(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
+                 const Quat& R2, const T* pe, const T* pd, T* S, Q<T>* qr_out = nullptr) {
+  Q<T> L1 = qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R1 * ref.O1));
+  Q<T> L2 = qmul(qmul(qsmall(pe + 9), qsmall(pd + 9)), qconst<T>(R2 * ref.O2));
+  L1 = qnormalize(L1);
+  L2 = qnormalize(L2);
+  T phi[3];
+  Q<T> qr;
+  relative_rotation(L1, L2, phi, qr);
   const double iL = 1.0 / ref.L0;
-  S[3] = 2.0 * f * rel.x * iL;
-  S[4] = 2.0 * f * rel.y * iL;
-  S[5] = 2.0 * f * rel.z * iL;
-  // half rotation: sqrt(rel) = normalize(1 + rel)
-  Q<T> half = qnormalize(Q<T>{rel.w + 1.0, rel.x, rel.y, rel.z});
-  Q<T> qr = qmul(L1, half);
+  S[3] = phi[0] * iL;
+  S[4] = phi[1] * iL;
+  S[5] = phi[2] * iL;
   T d[3];
   for (int i = 0; i < 3; ++i) d[i] = (T(x2(i)) + pe[6 + i] + pd[6 + i] - T(x1(i)) - pe[i] - pd[i]) * iL;
   T g[3];
@@ -114,26 +125,11 @@ Vec6 raw_strain_double(const ElementReference& ref, const Vec3& x1, const Vec3& 
 template <class T>
 void rotation_kernel(const ElementReference& ref, const Quat& R1, const Quat& R2, const T* pe,
                      const T* pd, T* phi, T* Qm) {
-  using std::sqrt;
-  using std::atan2;
   Q<T> L1 = qnormalize(qmul(qmul(qsmall(pe), qsmall(pd)), qconst<T>(R1 * ref.O1)));
   Q<T> L2 = qnormalize(qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R2 * ref.O2)));
-  Q<T> rel = qmul(qconj(L1), L2);
-  if (val(rel.w) < 0.0) rel = {-rel.w, -rel.x, -rel.y, -rel.z};
-  T s = rel.x * rel.x + rel.y * rel.y + rel.z * rel.z;
-  T f;
-  const double sv = val(s), wv = val(rel.w);
-  if (sv < 1e-16 * wv * wv) {
-    T t2 = s / (rel.w * rel.w);
-    f = (1.0 - t2 / 3.0) / rel.w;
-  } else {
-    T nv = sqrt(s);
-    f = atan2(nv, rel.w) / nv;
-  }
-  phi[0] = 2.0 * f * rel.x;
-  phi[1] = 2.0 * f * rel.y;
-  phi[2] = 2.0 * f * rel.z;
-  Q<T> qr = qnormalize(qmul(L1, qnormalize(Q<T>{rel.w + 1.0, rel.x, rel.y, rel.z})));
+  Q<T> qr;
+  relative_rotation(L1, L2, phi, qr);
+  qr = qnormalize(qr);
   // Λ_rᵀ = (w² − v·v) I + 2 v vᵀ − 2 w [v]×
   const T a = qr.w * qr.w - (qr.x * qr.x + qr.y * qr.y + qr.z * qr.z);
   const T v[3] = {qr.x, qr.y, qr.z};

@@ -166,4 +166,19 @@ inline FaceX cylinder_tri6(double Rc = 1.0) {
   return X;
 }
 
+// Sums per-face contact contributions into a dense residual (and tangent if K is given) over n nodes.
+inline Eigen::VectorXd assemble_dense(const std::vector<NodalContribution>& contributions, int n,
+                                      Eigen::MatrixXd* K) {
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
+  if (K) K->setZero(3 * n, 3 * n);
+  for (const NodalContribution& c : contributions)
+    for (std::size_t a = 0; a < c.nodes.size(); ++a) {
+      r.segment<3>(3 * c.nodes[a]) += c.r.segment<3>(3 * a);
+      if (K)
+        for (std::size_t b = 0; b < c.nodes.size(); ++b)
+          K->block<3, 3>(3 * c.nodes[a], 3 * c.nodes[b]) += c.K.block<3, 3>(3 * a, 3 * b);
+    }
+  return r;
+}
+
 }  // namespace angio::contact::test

@@ -259,16 +259,7 @@ TEST(LineContact, AssembledTangentMatchesFiniteDifferences) {
     par.compute_tangent = K != nullptr;
     const LineContactResult res = evaluate_line_contact(pts, s, par);
     energy = res.diag.energy;
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
-    if (K) K->setZero(3 * n, 3 * n);
-    for (const NodalContribution& c : res.solid)
-      for (std::size_t a = 0; a < c.nodes.size(); ++a) {
-        r.segment<3>(3 * c.nodes[a]) += c.r.segment<3>(3 * a);
-        if (K)
-          for (std::size_t b = 0; b < c.nodes.size(); ++b)
-            K->block<3, 3>(3 * c.nodes[a], 3 * c.nodes[b]) += c.K.block<3, 3>(3 * a, 3 * b);
-      }
-    return r;
+    return assemble_dense(res.solid, n, K);
   };
   Eigen::VectorXd u(3 * n);
   for (int i = 0; i < n; ++i) u.segment<3>(3 * i) = m.x[i];

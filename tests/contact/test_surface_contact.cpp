@@ -216,16 +216,7 @@ TEST(SurfaceContact, AssembledTangentMatchesFiniteDifferences) {
     par.compute_tangent = K != nullptr;
     const SurfaceContactResult res = evaluate_surface_contact(Ss, Sm, par);
     energy = res.diag.energy;
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
-    if (K) K->setZero(3 * n, 3 * n);
-    for (const NodalContribution& c : res.contributions)
-      for (std::size_t a = 0; a < c.nodes.size(); ++a) {
-        r.segment<3>(3 * c.nodes[a]) += c.r.segment<3>(3 * a);
-        if (K)
-          for (std::size_t b = 0; b < c.nodes.size(); ++b)
-            K->block<3, 3>(3 * c.nodes[a], 3 * c.nodes[b]) += c.K.block<3, 3>(3 * a, 3 * b);
-      }
-    return r;
+    return assemble_dense(res.contributions, n, K);
   };
   Eigen::VectorXd u(3 * n);
   for (int i = 0; i < n; ++i) u.segment<3>(3 * i) = all.x[i];
