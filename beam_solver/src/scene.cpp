@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
+
+#include "angio/geometry/centerline_scene.hpp"
 
 namespace angio::beam {
 
@@ -156,21 +159,12 @@ BeamScene beam_scene_from(const Node& root) {
     p.elements_per_connector =
         static_cast<int>(g->integer_or("elements_per_connector", p.elements_per_connector, 1));
     p.start = g->number_or("start", -1);
-    std::vector<Vec3> cl;
-    if (auto c = g->optional("centerline")) {
-      c->check_keys({"file", "points"});
-      if (c->has("file")) {
-        try {
-          cl = read_centerline(scene::resolve_path(*c, c->string("file")));
-        } catch (const std::runtime_error& e) {
-          c->child("file").fail(std::string("a readable centerline file (") + e.what() + ")");
-        }
-      } else {
-        cl = read_points(c->child("points", "a list of points [x, y, z]"));
-      }
-    }
+    // centerline: {file} | {points}: the same key shape as balloon/artery.mesh.centerline, so
+    // one centerline file places stent and balloon on the same curved axis (paper §2.4)
+    std::optional<geometry::Centerline> cl;
+    if (auto c = g->optional("centerline")) cl = geometry::centerline_from_scene(*c);
     try {
-      bs.stent = generate_corrugated_rings(p, cl);
+      bs.stent = cl ? generate_corrugated_rings(p, *cl) : generate_corrugated_rings(p);
     } catch (const std::invalid_argument& e) {
       g->fail(std::string("consistent stent parameters (") + e.what() + ")");
     }

@@ -1,137 +1,48 @@
 #include "angio/beam/stent_generator.hpp"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 
 namespace angio::beam {
 
-std::vector<std::array<Vec3, 3>> rotation_minimizing_frames(const std::vector<Vec3>& pts) {
-  const int n = static_cast<int>(pts.size());
-  if (n < 2) throw std::invalid_argument("centerline needs at least 2 points");
-  std::vector<Vec3> t(n);
-  for (int i = 0; i < n; ++i) {
-    const Vec3 a = pts[std::max(i - 1, 0)], b = pts[std::min(i + 1, n - 1)];
-    t[i] = (b - a).normalized();
-  }
-  std::vector<std::array<Vec3, 3>> F(n);
-  Vec3 r0 = Vec3::UnitX();
-  if (std::abs(r0.dot(t[0])) > 0.9) r0 = Vec3::UnitY();
-  r0 = (r0 - r0.dot(t[0]) * t[0]).normalized();
-  F[0] = {t[0], r0, t[0].cross(r0)};
-  for (int i = 0; i + 1 < n; ++i) {
-    const Vec3 v1 = pts[i + 1] - pts[i];
-    const double c1 = v1.dot(v1);
-    const Vec3 rL = F[i][1] - (2.0 / c1) * v1.dot(F[i][1]) * v1;
-    const Vec3 tL = t[i] - (2.0 / c1) * v1.dot(t[i]) * v1;
-    const Vec3 v2 = t[i + 1] - tL;
-    const double c2 = v2.dot(v2);
-    Vec3 r = c2 > 1e-30 ? Vec3(rL - (2.0 / c2) * v2.dot(rL) * v2) : rL;
-    r = (r - r.dot(t[i + 1]) * t[i + 1]).normalized();
-    F[i + 1] = {t[i + 1], r, t[i + 1].cross(r)};
-  }
-  return F;
-}
-
-std::vector<Vec3> read_centerline(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open centerline file");
-  std::vector<Vec3> pts;
-  std::string line;
-  int ln = 0;
-  while (std::getline(in, line)) {
-    ++ln;
-    const auto h = line.find('#');
-    if (h != std::string::npos) line.resize(h);
-    for (char& c : line)
-      if (c == ',' || c == ';' || c == '\t') c = ' ';
-    std::istringstream is(line);
-    double x, y, z;
-    if (!(is >> x)) continue;
-    if (!(is >> y >> z))
-      throw std::runtime_error(path + ":" + std::to_string(ln) + ": expected three numbers x y z");
-    pts.emplace_back(x, y, z);
-  }
-  if (pts.size() < 2) throw std::runtime_error(path + ": centerline needs at least 2 points");
-  return pts;
-}
-
 namespace {
 
-// Maps straight-stent cylindrical coordinates (θ, z, r) onto a centerline.
-struct Warp {
-  std::vector<Vec3> pts;
-  std::vector<double> s;
-  std::vector<std::array<Vec3, 3>> F;
-  std::vector<Eigen::Quaterniond> Q;
-  double offset = 0;
-  bool straight = true;
+// Where the straight stent's cylindrical coordinates (θ, z, r) go: the straight stent along +z
+// from z = 0, or the warp onto a centerline with z = arc length − offset (paper §2.4; see
+// angio::geometry::Centerline::map).
+struct Placement {
+  const geometry::Centerline* centerline = nullptr;
+  double offset = 0;  // mm, arc length where the stent starts
 
-  void locate(double z, Vec3& c, Vec3& n1, Vec3& n2) const {
-    if (straight) {
-      c = Vec3(0, 0, z);
-      n1 = Vec3::UnitX();
-      n2 = Vec3::UnitY();
-      return;
-    }
-    const double sa = z + offset;
-    int i = 0;
-    const int m = static_cast<int>(s.size());
-    while (i + 2 < m && sa > s[i + 1]) ++i;
-    const double len = s[i + 1] - s[i];
-    const double t = (sa - s[i]) / len;  // may be outside [0,1] at the ends (extrapolation)
-    c = pts[i] + t * (pts[i + 1] - pts[i]);
-    const double tc = std::clamp(t, 0.0, 1.0);
-    const Eigen::Quaterniond q = Q[i].slerp(tc, Q[i + 1]);
-    const Mat3 R = q.toRotationMatrix();
-    n1 = R.col(1);
-    n2 = R.col(2);
-  }
   Vec3 map(double theta, double z, double r) const {
-    Vec3 c, n1, n2;
-    locate(z, c, n1, n2);
-    return c + r * (std::cos(theta) * n1 + std::sin(theta) * n2);
+    if (centerline) return centerline->map(theta, z + offset, r);
+    return Vec3(0, 0, z) + r * (std::cos(theta) * Vec3::UnitX() + std::sin(theta) * Vec3::UnitY());
   }
   Vec3 radial(double theta, double z) const {
-    Vec3 c, n1, n2;
-    locate(z, c, n1, n2);
-    return std::cos(theta) * n1 + std::sin(theta) * n2;
+    if (centerline) return centerline->radial(theta, z + offset);
+    return std::cos(theta) * Vec3::UnitX() + std::sin(theta) * Vec3::UnitY();
   }
 };
 
-}  // namespace
-
-StentMesh generate_corrugated_rings(const StentParameters& p, const std::vector<Vec3>& centerline) {
+StentMesh generate(const StentParameters& p, const geometry::Centerline* centerline) {
   if (p.rings < 1 || p.crowns < 2 || p.connectors < 0 || p.elements_per_strut < 1 ||
       p.elements_per_connector < 1 || !(p.crimped_diameter > 0) || !(p.strut_height > 0) ||
       !(p.ring_pitch > 0))
     throw std::invalid_argument("invalid stent parameters");
   if (p.connectors > p.crowns) throw std::invalid_argument("more connectors than crowns");
-  Warp W;
+  Placement W;
   const double length = (p.rings - 1) * p.ring_pitch + p.strut_height;
-  if (!centerline.empty()) {
-    W.straight = false;
-    W.pts = centerline;
-    W.s.assign(centerline.size(), 0.0);
-    for (size_t i = 1; i < centerline.size(); ++i)
-      W.s[i] = W.s[i - 1] + (centerline[i] - centerline[i - 1]).norm();
-    W.F = rotation_minimizing_frames(centerline);
-    for (const auto& f : W.F) {
-      Mat3 R;
-      R.col(0) = f[0];
-      R.col(1) = f[1];
-      R.col(2) = f[2];
-      W.Q.emplace_back(R);
-    }
-    W.offset = p.start >= 0 ? p.start : 0.5 * (W.s.back() - length);
-    if (W.offset < 0 || W.offset + length > W.s.back() + 1e-9)
+  if (centerline) {
+    W.centerline = centerline;
+    const double L = centerline->length();
+    W.offset = p.start >= 0 ? p.start : 0.5 * (L - length);
+    if (W.offset < 0 || W.offset + length > L + 1e-9)
       throw std::invalid_argument("stent (" + std::to_string(length) +
-                                  " mm) does not fit on the centerline (" +
-                                  std::to_string(W.s.back()) + " mm)");
+                                  " mm) does not fit on the centerline (" + std::to_string(L) +
+                                  " mm" + (p.start >= 0 ? ", starting at " + std::to_string(p.start) + " mm" : "") +
+                                  ")");
   }
   StentMesh m;
   const double r = 0.5 * p.crimped_diameter;
@@ -195,11 +106,23 @@ StentMesh generate_corrugated_rings(const StentParameters& p, const std::vector<
     m.central_nodes.push_back(crown_node[{(p.rings - 1) / 2, j}]);
     if (p.rings % 2 == 0) m.central_nodes.push_back(crown_node[{p.rings / 2, j}]);
   }
-  if (W.straight)
+  if (!centerline)
     m.axis = {Vec3(0, 0, -1.0), Vec3(0, 0, length + 1.0)};
   else
-    m.axis = centerline;
+    m.axis = centerline->points();
   return m;
+}
+
+}  // namespace
+
+StentMesh generate_corrugated_rings(const StentParameters& p, const std::vector<Vec3>& centerline) {
+  if (centerline.empty()) return generate(p, nullptr);
+  const geometry::Centerline cl(centerline);  // std::invalid_argument if degenerate
+  return generate(p, &cl);
+}
+
+StentMesh generate_corrugated_rings(const StentParameters& p, const geometry::Centerline& centerline) {
+  return generate(p, &centerline);
 }
 
 }  // namespace angio::beam

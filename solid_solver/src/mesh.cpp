@@ -99,6 +99,18 @@ void set_frames_from_centerline(Mesh& m, const std::vector<Vec3d>& cl) {
   }
 }
 
+void set_frames_from_curved_axis(Mesh& m, const geometry::Centerline& cl) {
+  m.frames.resize(m.elements.size());
+  for (size_t e = 0; e < m.elements.size(); ++e) {
+    const auto p = cl.closest(element_centroid(m, int(e)));
+    Frame f;
+    f.axial = p.frame.tangent;
+    f.radial = p.distance > 1e-12 ? p.radial : p.frame.normal1;
+    f.circumferential = f.axial.cross(f.radial).normalized();
+    m.frames[e] = f;
+  }
+}
+
 namespace {
 using Key = std::array<int, 3>;
 struct KeyHash {
@@ -170,6 +182,10 @@ Mesh make_tube(const TubeSpec& s) {
     }
     m.blocks.push_back({L.name, s.part});
   }
+  if (s.centerline && (s.start < -1e-9 || s.start + s.length > s.centerline->length() + 1e-9))
+    throw std::runtime_error("tube: " + std::to_string(s.length) + " mm starting at arc length " +
+                             std::to_string(s.start) + " mm does not fit on the centerline (" +
+                             std::to_string(s.centerline->length()) + " mm)");
   const int nc = s.n_circ, nr = int(radii.size()), na = s.n_axial + 1;
   auto node = [&](int i, int j, int k) { return (k * nr + j) * nc + (i % nc); };
   const double z0 = s.center.z() - 0.5 * s.length;
@@ -177,8 +193,11 @@ Mesh make_tube(const TubeSpec& s) {
     for (int j = 0; j < nr; ++j)
       for (int i = 0; i < nc; ++i) {
         const double th = 2.0 * std::numbers::pi * i / nc;
-        m.X.push_back(Vec3d(s.center.x() + radii[j] * std::cos(th), s.center.y() + radii[j] * std::sin(th),
-                            z0 + s.length * k / s.n_axial));
+        if (s.centerline)  // warp of the straight tube (paper §2.4), same map as the stent's
+          m.X.push_back(s.centerline->map(th, s.start + s.length * k / s.n_axial, radii[j]));
+        else
+          m.X.push_back(Vec3d(s.center.x() + radii[j] * std::cos(th), s.center.y() + radii[j] * std::sin(th),
+                              z0 + s.length * k / s.n_axial));
       }
   for (int k = 0; k + 1 < na; ++k)
     for (int j = 0; j + 1 < nr; ++j)
@@ -222,7 +241,10 @@ Mesh make_tube(const TubeSpec& s) {
   m.node_sets[s.surface_prefix + "outer"] = outer_nodes;
   m.node_sets[s.surface_prefix + "inner"] = inner_nodes;
   m.orient_surfaces();
-  set_frames_from_axis(m, Axis{s.center, Vec3d::UnitZ()});
+  if (s.centerline)
+    set_frames_from_curved_axis(m, *s.centerline);  // longitudinal fibers along the curved axis
+  else
+    set_frames_from_axis(m, Axis{s.center, Vec3d::UnitZ()});
   return m;
 }
 

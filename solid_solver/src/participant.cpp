@@ -38,10 +38,12 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     const auto& nodes = model_->mesh().node_sets.at(d.node_set);
     auto ring = [&](double target) {
       double best = std::numeric_limits<double>::max();
-      for (int n : nodes) best = std::min(best, std::abs((model_->mesh().X[n] - d.axis.origin).dot(d.axis.direction) - target));
+      std::vector<double> st(nodes.size());  // axial station (arc length on a curved balloon)
+      for (size_t i = 0; i < nodes.size(); ++i) st[i] = d.station(model_->mesh().X[nodes[i]]);
+      for (double s : st) best = std::min(best, std::abs(s - target));
       std::vector<int> r;
-      for (int n : nodes)
-        if (std::abs((model_->mesh().X[n] - d.axis.origin).dot(d.axis.direction) - target) <= best + 1e-6) r.push_back(n);
+      for (size_t i = 0; i < nodes.size(); ++i)
+        if (std::abs(st[i] - target) <= best + 1e-6) r.push_back(nodes[i]);
       return r;
     };
     ring_mid_ = ring(d.s_mid);
@@ -72,14 +74,10 @@ SolidRunner::~SolidRunner() = default;
 void SolidRunner::balloon_diameters(double& mid, double& end0, double& end1) const {
   mid = end0 = end1 = 0.0;
   if (!scene_.balloon_diameter) return;
-  const auto& ax = scene_.balloon_diameter->axis;
+  const auto& d = *scene_.balloon_diameter;
   auto diam = [&](const std::vector<int>& ring) {
     double sum = 0.0;
-    for (int n : ring) {
-      Vec3d r = model_->position(n) - ax.origin;
-      r -= r.dot(ax.direction) * ax.direction;
-      sum += r.norm();
-    }
+    for (int n : ring) sum += d.radius(model_->position(n));  // from the (curved) reference axis
     return ring.empty() ? 0.0 : 2.0 * sum / double(ring.size());
   };
   mid = diam(ring_mid_);
@@ -191,7 +189,8 @@ void SolidRunner::write_summary_json_() const {
   if (scene_.balloon_diameter) {
     const auto& d = *scene_.balloon_diameter;
     j << "  \"balloon_diameter_stations\": {\"mid\": " << d.s_mid << ", \"end0\": " << d.s_end0
-      << ", \"end1\": " << d.s_end1 << ", \"measure\": \"2 x mean distance of the outer-surface node ring from the axis\"},\n";
+      << ", \"end1\": " << d.s_end1 << ", \"measure\": \"2 x mean distance of the outer-surface node ring from the axis"
+      << (d.centerline ? " (the curved centerline of the balloon)" : "") << "\"},\n";
   }
   j << "  \"steps\": [\n";
   for (size_t i = 0; i < history_.size(); ++i) {

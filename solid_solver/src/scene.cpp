@@ -4,6 +4,8 @@
 #include <limits>
 #include <set>
 
+#include "angio/geometry/centerline_scene.hpp"
+
 namespace angio::solid {
 
 namespace {
@@ -50,8 +52,10 @@ Axis read_axis(const Node& parent, const Vec3d& default_origin) {
 }
 
 // mesh: {generator: tube, ...} or {file: x.msh, ...}; returns the mesh with part-prefixed surfaces.
+// `curved` is set for a generated tube warped onto mesh.centerline (paper §2.4, §3.2).
 Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axis& axis,
-                    std::vector<std::string>& required_surfaces, double& length) {
+                    std::vector<std::string>& required_surfaces, double& length,
+                    std::optional<geometry::Centerline>& curved) {
   const std::string prefix = part + "_";
   if (mesh.has("file")) {
     mesh.check_keys({"file", "scale", "inner", "outer", "ends", "axis", "centerline"});
@@ -64,11 +68,9 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     }
     axis = read_axis(mesh, Vec3d::Zero());
     if (auto cl = mesh.optional("centerline")) {
-      // fiber frames from a lumen centerline (patient-specific arteries): list of points [x, y, z]
-      if (!cl->is_sequence() || cl->size() < 2) cl->fail("a list of at least two points [x, y, z]");
-      std::vector<Vec3d> pts;
-      for (size_t i = 0; i < cl->size(); ++i) pts.push_back(v3(cl->at(i).as_vec3()));
-      set_frames_from_centerline(m, pts);
+      // fiber frames from a lumen centerline (patient-specific arteries): [[x, y, z], ...],
+      // {points: [...]} or {file: ...} (the key shape of the tube generator and the stent)
+      set_frames_from_centerline(m, geometry::centerline_from_scene(*cl).points());
     } else {
       set_frames_from_axis(m, axis);
     }
@@ -115,9 +117,9 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     return m;
   }
   mesh.check_keys(layered ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ",
-                                                               "n_axial", "center", "layers"}
+                                                               "n_axial", "center", "layers", "centerline", "start"}
                           : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall",
-                                                               "n_circ", "n_axial", "center"});
+                                                               "n_circ", "n_axial", "center", "centerline", "start"});
   mesh.choice("generator", {"tube"});
   TubeSpec t;
   t.part = part;
@@ -147,9 +149,36 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   }
   t.inner_radius = ro - wall;
   if (!(t.inner_radius > 0)) mesh.child("outer_diameter").fail("an outer diameter larger than twice the wall thickness");
+  if (auto cl = mesh.optional("centerline")) {
+    // curved tube: the straight tube warped onto the centerline like the stent (paper §2.4)
+    if (mesh.has("center")) mesh.child("center").fail("no 'center' with a 'centerline' (a curved tube is placed by centerline and start)");
+    geometry::Centerline c = geometry::centerline_from_scene(*cl);
+    const std::string source = cl->is_map() && cl->has("file") ? cl->string("file") : "the given points";
+    if (mesh.has("start")) {
+      t.start = mesh.non_negative("start");
+      if (t.start + t.length > c.length() + 1e-9)
+        mesh.child("start").fail("a start arc length with start + length (" + std::to_string(t.start + t.length) +
+                                 " mm) within the centerline (" + source + ", " + std::to_string(c.length()) +
+                                 " mm long)");
+    } else {
+      t.start = 0.5 * (c.length() - t.length);  // centred, as the stent generator's default
+      if (t.start < -1e-9)
+        mesh.child("length").fail("a tube no longer than the centerline (" + source + ", " +
+                                  std::to_string(c.length()) + " mm long), got " + std::to_string(t.length) + " mm");
+      t.start = std::max(t.start, 0.0);
+    }
+    t.centerline = c;
+    curved = std::move(c);
+  } else if (mesh.has("start")) {
+    mesh.child("start").fail("no 'start' without a 'centerline'");
+  }
   axis = Axis{t.center, Vec3d::UnitZ()};
   length = t.length;
-  return make_tube(t);
+  try {
+    return make_tube(t);
+  } catch (const std::runtime_error& e) {
+    mesh.fail(std::string("a valid tube (") + e.what() + ")");
+  }
 }
 
 PressureSpec read_pressure(const Node& parent, const std::string& key, const std::string& surface,
@@ -209,8 +238,9 @@ SolidScene read_solid_scene(const Node& root) {
     Axis axis;
     std::vector<std::string> req;
     double length = 0;
+    std::optional<geometry::Centerline> curved;
     Mesh m = read_part_mesh(b->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false,
-                            axis, req, length);
+                            axis, req, length, curved);
     for (auto& blk : m.blocks) blk.name = m.blocks.size() == 1 ? "balloon" : "balloon_" + blk.name;
     const LayerMaterial mat = read_material(b->child("material", "a material {E, nu, fibers}"), "balloon");
     const int boff = int(sc.mesh.blocks.size());
@@ -232,9 +262,10 @@ SolidScene read_solid_scene(const Node& root) {
       DiameterSpec d;
       d.node_set = "balloon_outer";
       d.axis = axis;
+      d.centerline = curved;  // curved balloon: arc-length stations, radii from the centerline
       double smin = std::numeric_limits<double>::max(), smax = -smin;
       for (const auto& x : m.X) {
-        const double s = (x - axis.origin).dot(axis.direction);
+        const double s = d.station(x);
         smin = std::min(smin, s);
         smax = std::max(smax, s);
       }
@@ -259,8 +290,9 @@ SolidScene read_solid_scene(const Node& root) {
     Axis axis;
     std::vector<std::string> req;
     double length = 0;
+    std::optional<geometry::Centerline> curved;
     Mesh m = read_part_mesh(a->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis,
-                            req, length);
+                            req, length, curved);
     const Node layers = a->child("layers", "a map layer name -> material {E, nu, fibers}");
     if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
     for (const auto& blk : m.blocks) {

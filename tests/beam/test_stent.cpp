@@ -95,22 +95,7 @@ TEST(StentGenerator, WarpedStentKeepsStrutLengths) {
   for (const auto& x : warped.nodes) EXPECT_NEAR(ax.project(x).r, 0.575, 2e-3);
 }
 
-// Rotation-minimizing frames stay orthonormal and do not twist along a planar curve
-// (binormal constant for a planar arc).
-TEST(StentGenerator, RotationMinimizingFrame) {
-  std::vector<Vec3> pts;
-  for (int i = 0; i <= 50; ++i) {
-    const double a = 1.2 * i / 50;
-    pts.emplace_back(10 * (1 - std::cos(a)), 0, 10 * std::sin(a));
-  }
-  const auto F = rotation_minimizing_frames(pts);
-  for (const auto& f : F) {
-    EXPECT_NEAR(f[0].dot(f[1]), 0, 1e-12);
-    EXPECT_NEAR(f[1].norm(), 1, 1e-12);
-    // y is the binormal of the x–z plane arc: the frame vector along y must stay along y
-    EXPECT_NEAR(std::abs(f[2].y()) + std::abs(f[1].y()), 1.0, 1e-9);
-  }
-}
+// Rotation-minimizing frames: see tests/geometry/test_centerline.cpp (protocol/geometry).
 
 // The shipped scenes parse; a bad value gives "file: key.path: expected …".
 TEST(BeamScene, ShippedConfigsParse) {
@@ -167,11 +152,11 @@ TEST(StentGenerator, CenterlineFromFile) {
     for (size_t i = 0; i < pts.size(); ++i)
       f << pts[i].x() << (i % 2 ? ", " : " ") << pts[i].y() << " " << pts[i].z() << "\n";
   }
-  const auto read = read_centerline(path.string());
+  const auto read = angio::geometry::read_centerline_points(path.string());
   ASSERT_EQ(read.size(), pts.size());
   const StentMesh a = generate_corrugated_rings(StentParameters{}, pts);
   const StentMesh b = generate_corrugated_rings(StentParameters{}, read);
   for (size_t n = 0; n < a.nodes.size(); ++n) EXPECT_LT((a.nodes[n] - b.nodes[n]).norm(), 1e-12);
   std::filesystem::remove(path);
-  EXPECT_THROW(read_centerline("/nonexistent/centerline.txt"), std::runtime_error);
+  EXPECT_THROW(angio::geometry::read_centerline_points("/nonexistent/centerline.txt"), std::runtime_error);
 }

@@ -15,9 +15,11 @@
 //  * every strut and connector is split into elements_per_strut / elements_per_connector
 //    elements with nodes on the cylinder: 4 rings → 4·16·3 + 3·2·3 = 210 elements.
 //  * fixation nodes (radial motion only): 4 bottom crowns of the middle ring, 90° apart.
-// A curved stent is the straight one warped onto a centerline polyline: axial coordinate z =
-// arc length along the centerline (no stretching of the centerline) and the cross-section
-// frame transported with minimal twist (rotation-minimizing frame, double reflection method).
+// A curved stent is the straight one warped onto a centerline polyline (paper §2.4): axial
+// coordinate z = arc length along the centerline (no stretching of the centerline) and the
+// cross-section frame transported with minimal twist (rotation-minimizing frame, double
+// reflection method). The warp is angio::geometry::Centerline::map (protocol/geometry), the
+// same map the solid_solver uses for a curved balloon, so stent and balloon share one axis.
 #pragma once
 
 #include <array>
@@ -25,6 +27,7 @@
 #include <vector>
 
 #include "angio/beam/material.hpp"
+#include "angio/geometry/centerline.hpp"
 
 namespace angio::beam {
 
@@ -54,14 +57,11 @@ struct StentMesh {
   int num_struts = 0, num_connectors = 0;
 };
 
+// Straight stent along +z from z = 0 (centerline empty), or warped onto the centerline
+// starting at arc length p.start (−1: centred). Throws std::invalid_argument on bad parameters,
+// a centerline shorter than the stent, or a degenerate centerline.
 StentMesh generate_corrugated_rings(const StentParameters& p,
                                     const std::vector<Vec3>& centerline = {});
-
-// Rotation-minimizing frames (double reflection, Wang et al. 2008) at the polyline vertices:
-// returns for each vertex {tangent, normal1, normal2}.
-std::vector<std::array<Vec3, 3>> rotation_minimizing_frames(const std::vector<Vec3>& pts);
-
-// Reads a centerline polyline from a text file: one "x y z" (or "x,y,z") per line, '#' comments.
-std::vector<Vec3> read_centerline(const std::string& path);
+StentMesh generate_corrugated_rings(const StentParameters& p, const geometry::Centerline& centerline);
 
 }  // namespace angio::beam

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "angio/geometry/centerline.hpp"
 #include "angio/solid/elements.hpp"
 
 namespace angio::solid {
@@ -61,6 +62,10 @@ struct Mesh {
 // Structured hex8 tube: layers from inside to outside; blocks named after the layers,
 // surfaces <prefix>inner, <prefix>outer, <prefix>end0 (z = z0), <prefix>end1 (z = z0 + length).
 // Axis along +z through `center`, the tube spans z in [center.z - L/2, center.z + L/2].
+// Curved tube (paper §2.4, §3.2): with a centerline the straight tube's node (θ, z, r) goes to
+// centerline.map(θ, start + z, r), z in [0, length] (the axis is not stretched, the cross-section
+// frame has minimal twist: the same warp as the stent's); `center` is not used. Fiber frames
+// then follow the curved axis (set_frames_from_curved_axis).
 struct TubeLayer {
   std::string name;
   double thickness = 0.0;
@@ -75,7 +80,10 @@ struct TubeSpec {
   int n_circ = 16;
   int n_axial = 8;
   Vec3d center = Vec3d::Zero();
+  std::optional<geometry::Centerline> centerline;  // curved axis (none: straight along +z)
+  double start = 0.0;  // mm, arc length of end0 on the centerline
 };
+// Throws std::runtime_error on bad parameters or a tube that does not fit on the centerline.
 Mesh make_tube(const TubeSpec& spec);
 
 // gmsh .msh 4.x ASCII. Volume physical groups become blocks (name = physical name, or
@@ -92,6 +100,10 @@ void set_frames_from_axis(Mesh& m, const Axis& axis);
 // Fill m.frames from a polyline centerline (>= 2 points): axial = tangent of the closest segment,
 // radial = centroid minus its closest point (without the axial part), circumferential = axial x radial.
 void set_frames_from_centerline(Mesh& m, const std::vector<Vec3d>& centerline);
+// Fill m.frames w.r.t. a curved device axis (warped tubes): at the element centroid c,
+// axial = tangent of centerline.frame(s) at s = centerline.closest(c).s, radial = c minus its
+// foot (normal to the tangent), circumferential = axial x radial (right-handed, orthonormal).
+void set_frames_from_curved_axis(Mesh& m, const geometry::Centerline& centerline);
 Vec3d element_centroid(const Mesh& m, int e);
 
 }  // namespace angio::solid
