@@ -1,5 +1,7 @@
 #include "angio/beam/model.hpp"
 
+#include "angio/participant/plane_penalty.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -202,14 +204,28 @@ void BeamModel::set_sample_line_loads(const std::vector<Vec3>& q) {
                                 " sample line loads, got " + std::to_string(q.size()));
   q_ext_ = q;
 }
+void BeamModel::set_sample_planes(std::vector<SamplePlane> planes) {
+  if (!planes.empty() && static_cast<int>(planes.size()) != num_sample_points())
+    throw std::invalid_argument("expected " + std::to_string(num_sample_points()) +
+                                " contact planes, got " + std::to_string(planes.size()));
+  planes_ = std::move(planes);
+}
+std::vector<Vec3> BeamModel::sample_contact_loads() const {
+  std::vector<Vec3> q = q_ext_;
+  for (size_t g = 0; g < planes_.size(); ++g)
+    q[g] += participant::plane_penalty(sample_position(int(g)), planes_[g].s, planes_[g].n, planes_[g].eps,
+                                      sample_radius(int(g)), planes_[g].g0).q;
+  return q;
+}
 std::vector<Vec3> BeamModel::sample_load_nodal_forces() const {
   std::vector<Vec3> f(num_nodes(), Vec3::Zero());
+  const std::vector<Vec3> q = sample_contact_loads();
   for (int g = 0; g < num_sample_points(); ++g) {
     const int e = g / sample_points_per_element, k = g % sample_points_per_element;
     const auto [a, b] = elem_nodes_[e];
     const double w = sample_weight(g);
-    f[a] += (1.0 - gauss_xi_[k]) * w * q_ext_[g];
-    f[b] += gauss_xi_[k] * w * q_ext_[g];
+    f[a] += (1.0 - gauss_xi_[k]) * w * q[g];
+    f[b] += gauss_xi_[k] * w * q[g];
   }
   return f;
 }
@@ -319,6 +335,17 @@ void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
       const double N2 = gauss_xi_[k], N1 = 1.0 - N2;
       const double w = gauss_w_[k] * eref_[e].L0;
       Vec3 q = q_ext_[g] + eq[e] + epd[e] * ref_radial_[g];
+      if (!planes_.empty() && planes_[g].eps > 0.0) {
+        const participant::PlanePenalty pp = participant::plane_penalty(N1 * x_[a] + N2 * x_[b], planes_[g].s, planes_[g].n,
+                                              planes_[g].eps, sections_[elem_section_[e]].contact_radius, planes_[g].g0);
+        q += pp.q;
+        if (K && pp.gap < planes_[g].g0) {
+          Ke.block<3, 3>(0, 0) -= N1 * N1 * w * pp.dq_dx;
+          Ke.block<3, 3>(0, 6) -= N1 * N2 * w * pp.dq_dx;
+          Ke.block<3, 3>(6, 0) -= N2 * N1 * w * pp.dq_dx;
+          Ke.block<3, 3>(6, 6) -= N2 * N2 * w * pp.dq_dx;
+        }
+      }
       if (ep[e] != 0.0) {
         const Vec3 xg = N1 * x_[a] + N2 * x_[b];
         const auto pr = axis.project(xg);

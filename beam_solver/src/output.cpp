@@ -133,7 +133,7 @@ void BeamOutput::write_step(const BeamModel& m, int step, double time) {
   std::vector<Vec3> sx(ng_);
   for (int i = 0; i < ng_; ++i) sx[i] = m.sample_position(i);
   write_dataset(g, "sample_positions", flat(sx), ng_, 3);
-  write_dataset(g, "contact_line_loads", flat(m.sample_line_loads()), ng_, 3);
+  write_dataset(g, "contact_line_loads", flat(m.sample_contact_loads()), ng_, 3);
   H5Gclose(g);
   H5Fflush(f, H5F_SCOPE_GLOBAL);
   steps_.push_back({step, time, std::string(name).substr(1)});

@@ -77,7 +77,33 @@ void BeamSolverParticipant::begin_step(int step, double time) {
   LOG_DEBUG("begin step " << step << " t = " << time);
 }
 
+participant::SolveStats BeamSolverParticipant::solve_with_planes(const std::vector<participant::Vec3>& q,
+                                                                 const participant::ContactPlanes& planes) {
+  BeamModel& m = *scene_.model;
+  if (static_cast<int>(planes.size()) != m.num_sample_points() || planes.s.size() != planes.size() ||
+      planes.n.size() != planes.size()) {
+    participant::SolveStats out;
+    out.message = "expected " + std::to_string(m.num_sample_points()) + " contact planes, got " +
+                  std::to_string(planes.size());
+    return out;
+  }
+  std::vector<BeamModel::SamplePlane> p(planes.size());
+  for (size_t g = 0; g < p.size(); ++g) {
+    p[g].s = Vec3(planes.s[g][0], planes.s[g][1], planes.s[g][2]);
+    p[g].n = Vec3(planes.n[g][0], planes.n[g][1], planes.n[g][2]);
+    p[g].eps = planes.eps[g];
+    p[g].g0 = planes.g0;
+  }
+  m.set_sample_planes(std::move(p));  // kept for the step's output; the next solve() clears them
+  return solve_loads_(q);
+}
+
 participant::SolveStats BeamSolverParticipant::solve(const std::vector<participant::Vec3>& q) {
+  scene_.model->set_sample_planes({});
+  return solve_loads_(q);
+}
+
+participant::SolveStats BeamSolverParticipant::solve_loads_(const std::vector<participant::Vec3>& q) {
   BeamModel& m = *scene_.model;
   participant::SolveStats out;
   if (!q.empty()) {

@@ -5,28 +5,15 @@
 #include <sstream>
 
 #include "angio/common/log.hpp"
+#include "angio/coupler/interface_scheme.hpp"
 
 namespace angio::coupler {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using participant::Vec3;
 
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-Eigen::VectorXd flatten(const std::vector<Vec3>& v) {
-  Eigen::VectorXd out(3 * v.size());
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int d = 0; d < 3; ++d) out[3 * i + d] = v[i][d];
-  return out;
-}
-
-std::vector<Vec3> unflatten(const Eigen::VectorXd& x) {
-  std::vector<Vec3> out(x.size() / 3);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
-  return out;
 }
 
 std::string history(const std::vector<double>& h) {
@@ -46,9 +33,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
   const auto run_start = Clock::now();
   const std::size_t n = beam.sample_points().size();
   const double sqrt_len = std::sqrt(static_cast<double>(3 * n));
-  // Converged interface loads of the last two steps, for the prediction of the first iterate.
-  Eigen::VectorXd q_last = Eigen::VectorXd::Zero(3 * n), q_before = q_last;
-  double dt_last = 0.0;
+  auto scheme = make_interface_scheme(settings.scheme, n);
 
   auto step_start = Clock::now();
   while (!stepper.finished()) {
@@ -60,15 +45,13 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     solid.begin_step(rep.step, rep.time);
     acc.begin_step();
 
-    Eigen::VectorXd q = q_last;
-    if (settings.prediction == "extrapolate" && dt_last > 0.0)
-      q += (stepper.increment() / dt_last) * (q_last - q_before);
+    scheme->begin_step(stepper.increment(), settings.prediction == "extrapolate");
 
     bool converged = false, participant_failed = false;
     std::string failure;
     for (int k = 0; k < settings.max_iterations; ++k) {
       auto t0 = Clock::now();
-      participant::SolveStats bs = beam.solve(unflatten(q));  // Neumann: loads in, positions out
+      participant::SolveStats bs = scheme->solve_beam(beam);
       rep.beam_time += since(t0);
       if (!bs.converged) {
         participant_failed = true;
@@ -78,7 +61,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       }
       rep.beam_points = beam.sample_points();
       t0 = Clock::now();
-      participant::SolveStats ss = solid.solve(rep.beam_points, rep.contact);  // Dirichlet
+      participant::SolveStats ss = solid.solve(rep.beam_points, rep.contact);  // positions in
       rep.solid_time += since(t0);
       if (!ss.converged) {
         participant_failed = true;
@@ -86,29 +69,29 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
                   ss.message + ", residual history " + history(ss.residual_history);
         break;
       }
-      const Eigen::VectorXd q_tilde = flatten(rep.contact.line_loads);
-      if (q_tilde.size() != q.size())
-        throw std::runtime_error("solid returned " + std::to_string(q_tilde.size() / 3) +
+      const auto& reply = rep.contact;
+      if (reply.line_loads.size() != n)
+        throw std::runtime_error("solid returned " + std::to_string(reply.line_loads.size()) +
                                  " line loads for " + std::to_string(n) + " sample points");
-      if (!q_tilde.allFinite()) {
+      const Eigen::VectorXd r = scheme->force_residual(rep.beam_points, reply);
+      if (!r.allFinite()) {
         participant_failed = true;
-        failure = "solid returned non-finite contact line loads";
+        failure = "solid returned non-finite contact line loads or planes";
         break;
       }
-      const Eigen::VectorXd r = q_tilde - q;
+      double q_norm = 0.0;
+      for (const auto& q : reply.line_loads) q_norm += q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
+      q_norm = std::sqrt(q_norm);
       const double rn = r.norm();
       rep.residuals.push_back(rn);
       rep.iterations = k + 1;
       LOG_DEBUG("step " << rep.step << " iteration " << k << ": ||r|| = " << rn << ", ||q~|| = "
-                        << q_tilde.norm() << ", omega = " << acc.last_factor());
-      if (rn <= settings.rel_tol * q_tilde.norm() + settings.abs_tol * sqrt_len) {
+                        << q_norm << ", omega = " << acc.last_factor());
+      if (rn <= settings.rel_tol * q_norm + settings.abs_tol * sqrt_len) {
         converged = true;
-        // The solid state corresponds to x_k, and q~_k is the consistent load for it; the beam
-        // was solved with q_k, which agrees with q~_k to tolerance.
-        q = q_tilde;
         break;
       }
-      q = acc.update(q, r, k);
+      scheme->next_iterate(acc, k);
       rep.omega = acc.last_factor();
     }
 
@@ -135,9 +118,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     beam.end_step(true);
     solid.end_step(true);
     acc.end_step(true);
-    q_before = q_last;
-    q_last = q;
-    dt_last = stepper.increment();
+    scheme->accept(stepper.increment());
     rep.omega = acc.last_factor();
     rep.wall_time = since(step_start);
     run.steps++;

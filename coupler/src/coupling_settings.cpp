@@ -1,6 +1,10 @@
 #include "angio/coupler/coupling_settings.hpp"
 
+#include <stdexcept>
+
 #include "angio/coupler/aitken.hpp"
+#include "angio/coupler/dirichlet_neumann.hpp"
+#include "angio/coupler/robin.hpp"
 
 namespace angio::coupler {
 
@@ -8,14 +12,23 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   CouplingSettings s;
   auto c = root.optional("coupling");
   if (!c) return s;
-  c->check_keys({"acceleration", "initial_relaxation", "max_relaxation", "max_iterations",
-                 "rel_tol", "abs_tol", "strict", "prediction", "record"});
-  s.acceleration = c->choice_or("acceleration", {"aitken", "constant"}, s.acceleration);
+  c->check_keys({"scheme", "acceleration", "initial_relaxation", "max_relaxation", "max_iterations",
+                 "rel_tol", "abs_tol", "strict", "prediction", "record", "iqn"});
+  s.scheme = c->choice_or("scheme", {"dirichlet-neumann", "robin"}, s.scheme);
+  s.acceleration = c->choice_or("acceleration", {"aitken", "iqn-ils", "constant"}, s.acceleration);
   if (c->has("initial_relaxation")) s.initial_relaxation = c->in_range("initial_relaxation", 1e-6, 2.0);
   s.max_relaxation = c->has("max_relaxation") ? c->in_range("max_relaxation", 1e-6, 10.0)
                                               : std::max(1.0, s.initial_relaxation);
   if (s.max_relaxation < s.initial_relaxation)
     c->child("max_relaxation").fail("a value >= coupling.initial_relaxation");
+  if (auto iqn = c->optional("iqn")) {
+    if (s.acceleration != "iqn-ils") iqn->fail("no iqn section (it applies only with coupling.acceleration: iqn-ils)");
+    iqn->check_keys({"reused_steps", "max_columns", "filter"});
+    s.iqn.reused_steps = static_cast<int>(iqn->integer_or("reused_steps", s.iqn.reused_steps, 0));
+    s.iqn.max_columns = static_cast<int>(iqn->integer_or("max_columns", s.iqn.max_columns, 1));
+    if (iqn->has("filter")) s.iqn.filter = iqn->in_range("filter", 1e-14, 0.99);
+  }
+  s.iqn.initial_relaxation = s.initial_relaxation;
   s.max_iterations = static_cast<int>(c->integer_or("max_iterations", s.max_iterations, 1));
   s.rel_tol = c->non_negative_or("rel_tol", s.rel_tol);
   s.abs_tol = c->non_negative_or("abs_tol", s.abs_tol);
@@ -27,8 +40,15 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   return s;
 }
 
+std::unique_ptr<InterfaceScheme> make_interface_scheme(const std::string& name, std::size_t n_points) {
+  if (name == "robin") return std::make_unique<Robin>(n_points);
+  if (name == "dirichlet-neumann") return std::make_unique<DirichletNeumann>(n_points);
+  throw std::invalid_argument("unknown coupling scheme '" + name + "' (dirichlet-neumann | robin)");
+}
+
 std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s) {
   if (s.acceleration == "constant") return std::make_unique<ConstantRelaxation>(s.initial_relaxation);
+  if (s.acceleration == "iqn-ils") return std::make_unique<IqnIls>(s.iqn);
   return std::make_unique<Aitken>(s.initial_relaxation, s.max_relaxation);
 }
 

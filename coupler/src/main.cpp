@@ -78,7 +78,7 @@ int run(const cli::Parser& args) {
   const std::string solid_sw = solid.hello();
   LOG_INFO("run " << run_id << ": beam " << beam_sw << " (" << beam.sample_points().size()
                   << " contact sample points), solid " << solid_sw << "; " << time.steps
-                  << " steps to t = " << time.end << " s, " << settings.acceleration
+                  << " steps to t = " << time.end << " s, " << settings.scheme << " coupling with " << settings.acceleration
                   << " acceleration");
 
   coupler::StepCsv csv((run_dir / "coupling.csv").string());

@@ -146,6 +146,7 @@ void PenaltyStentContact::evaluate_(const SolidModel& model, bool tangent, Eval&
     const contact::SurfaceSearch* one[] = {searches_[k].get()};
     contact::LineContactParams par;
     par.penalty = penalty_[k];
+    par.regularization = opt_.regularization;
     par.compute_tangent = tangent;
     out.per_surface.push_back(contact::evaluate_line_contact(points_, one, par));
     out.diag.merge(out.per_surface.back().diag);
@@ -169,6 +170,8 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
         const contact::SurfaceSearch* one[] = {searches_[k].get()};
         contact::LineContactParams par;
         par.penalty = penalty_[k];
+        par.regularization = opt_.regularization;
+    par.regularization = opt_.regularization;
         par.compute_tangent = K != nullptr;
         const auto res = contact::evaluate_line_contact(mine, one, par);
         insert(model, res.solid, r, K);
@@ -221,6 +224,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
       reply.surface_points[i] = {pc.proj.s(0), pc.proj.s(1), pc.proj.s(2)};
       reply.normals[i] = {pc.proj.n(0), pc.proj.n(1), pc.proj.n(2)};
       reply.penalty[i] = penalty_[best];
+      reply.regularization = opt_.regularization;
       reply.min_gap = std::min(reply.min_gap, best_gap);
     }
     reply.active[i] = active ? 1 : 0;

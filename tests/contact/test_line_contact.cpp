@@ -8,9 +8,11 @@ using namespace angio::contact::test;
 
 namespace {
 // FD check of the solid tangent: K = d r / dX with the beam point fixed (r = dPi/dX = -forces).
-void check_tangent(FaceKind k, const FaceX& X, double sign, const BeamPoint& bp, double eps = 10.0) {
+void check_tangent(FaceKind k, const FaceX& X, double sign, const BeamPoint& bp, double eps = 10.0,
+                   double g0 = 0.0) {
   LineContactParams par;
   par.penalty = eps;
+  par.regularization = g0;
   par.beam_tangent = true;
   const Projection p = project(k, X, sign, bp.x);
   PointContact pc;
@@ -276,4 +278,31 @@ TEST(LineContact, AssembledTangentMatchesFiniteDifferences) {
       },
       u, 1e-6);
   EXPECT_LT(rel_diff(r.transpose(), rfd), 1e-6);
+}
+
+// Linear-quadratic (C¹) penalty law: compares against its closed form q = eps (g0/2 − g) for g ≤ 0,
+// eps (g0 − g)²/(2 g0) for 0 < g < g0, 0 beyond (continuous force and stiffness at g = 0 and at
+// g0), and the tangents against central finite differences in both branches.
+TEST(LineContact, LinearQuadraticLawMatchesClosedFormAndTangents) {
+  FaceX X(3, 4);
+  X << 0, 1, 1, 0, 0, 0, 1, 1, 0, 0, 0, 0;
+  const double eps = 10.0, R = 0.06, w = 0.2, g0 = 0.004;
+  LineContactParams par;
+  par.penalty = eps;
+  par.regularization = g0;
+  auto force = [&](double g) {
+    BeamPoint bp{Vec3(0.3, 0.6, R + g), w, R};
+    PointContact pc;
+    Eigen::VectorXd r;
+    line_point_kernel(bp, FaceKind::Quad4, X, 1.0, project(FaceKind::Quad4, X, 1.0, bp.x), par, pc, r, nullptr);
+    return pc.q.z();
+  };
+  EXPECT_NEAR(force(-0.01), eps * (0.5 * g0 + 0.01), 1e-14);
+  EXPECT_NEAR(force(0.001), 0.5 * eps * (g0 - 0.001) * (g0 - 0.001) / g0, 1e-15);
+  EXPECT_EQ(force(g0 + 1e-6), 0.0);
+  EXPECT_NEAR(force(-1e-9), force(1e-9), 1e-7);            // continuous at g = 0
+  // stiffness continuous at 0 (one-sided slopes −eps and −eps (1 − h/g0): difference O(eps h/g0))
+  EXPECT_NEAR((force(1e-7) - force(-1e-7)) / 2e-7, -eps, 1e-3);
+  check_tangent(FaceKind::Quad4, X, 1.0, BeamPoint{Vec3(0.3, 0.6, R - 0.01), w, R}, eps, g0);
+  check_tangent(FaceKind::Quad4, X, 1.0, BeamPoint{Vec3(0.3, 0.6, R + 0.002), w, R}, eps, g0);
 }

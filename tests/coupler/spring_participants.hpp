@@ -52,6 +52,20 @@ struct SpringBeam : participant::BeamParticipant {
     st.iterations = 1;
     return st;
   }
+  // Robin mode: kb (x − x0) = c + plane load, with the plane law of plane_penalty.hpp along x
+  // (normal ±e_x), solved in closed form for the active and the inactive branch.
+  participant::SolveStats solve_with_planes(const std::vector<Vec3>& c,
+                                            const participant::ContactPlanes& p) override {
+    participant::SolveStats st = solve(c);
+    for (int i = 0; i < n; ++i) {
+      if (!(p.eps[i] > 0.0)) continue;
+      const double nx = p.n[i][0], S = p.s[i][0], e = p.eps[i];
+      // q = −e·(nx (x − S) − R)·nx for nx (x − S) − R < 0; nx = ±1
+      const double x_act = (kb * x0 + c[i][0] + e * (S + nx * R)) / (kb + e);
+      if (nx * (x_act - S) - R < 0.0) x[i] = x_act;
+    }
+    return st;
+  }
   void end_step(bool accept) override {
     if (accept) {
       x_committed = x;
@@ -77,6 +91,11 @@ struct WallSolid : participant::SolidParticipant {
       const double g = s - p.x[i][0] - p.radius[i];
       const double q = eps * std::max(g, 0.0);
       reply.line_loads.push_back({q, 0.0, 0.0});
+      // robin data: the wall as a plane with normal +e_x toward the beam; the law
+      // −eps·((x − S) − R) with S = s − 2R equals eps·(s − x − R) above.
+      reply.surface_points.push_back({s - 2.0 * p.radius[i], p.x[i][1], p.x[i][2]});
+      reply.normals.push_back({1.0, 0.0, 0.0});
+      reply.penalty.push_back(eps);
       reply.total_force[0] += p.w[i] * q;
       if (g > 0) ++reply.n_active;
     }

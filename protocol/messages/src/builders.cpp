@@ -53,9 +53,18 @@ Buffer step_begin(const Header& h, std::uint32_t step, double time, double dt) {
 }
 
 Buffer beam_solve_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                          const std::vector<participant::Vec3>& line_loads) {
-  FlatBufferBuilder b(64 + 24 * line_loads.size());
-  auto p = fb::CreateBeamSolveRequest(b, step, iteration, vec3s(b, line_loads));
+                          const std::vector<participant::Vec3>& line_loads,
+                          const participant::ContactPlanes* planes) {
+  FlatBufferBuilder b(64 + 24 * line_loads.size() + (planes ? 56 * planes->size() : 0));
+  const auto q = vec3s(b, line_loads);
+  flatbuffers::Offset<flatbuffers::Vector<const fb::Vec3*>> s, n;
+  flatbuffers::Offset<flatbuffers::Vector<double>> eps;
+  if (planes) {
+    s = vec3s(b, planes->s);
+    n = vec3s(b, planes->n);
+    eps = b.CreateVector(planes->eps);
+  }
+  auto p = fb::CreateBeamSolveRequest(b, step, iteration, q, s, n, eps, planes ? planes->g0 : 0.0);
   return finish(b, h, fb::Payload::BeamSolveRequest, p.Union());
 }
 
@@ -85,7 +94,7 @@ Buffer solid_solve_reply(const Header& h, const participant::SolveStats& s, doub
   auto act = b.CreateVector(c.active);
   const fb::Vec3 f(c.total_force[0], c.total_force[1], c.total_force[2]);
   auto diag = fb::CreateContactDiagnostics(b, static_cast<std::uint32_t>(c.n_active), c.min_gap, &f);
-  auto p = fb::CreateSolidSolveReply(b, st, q, sp, n, eps, act, diag);
+  auto p = fb::CreateSolidSolveReply(b, st, q, sp, n, eps, act, diag, c.regularization);
   return finish(b, h, fb::Payload::SolidSolveReply, p.Union());
 }
 

@@ -42,6 +42,7 @@ participant::ContactReply to_contact(const fb::SolidSolveReply& r) {
   participant::ContactReply c;
   c.line_loads = to_vec3s(r.line_loads());
   c.surface_points = to_vec3s(r.surface_points());
+  c.regularization = r.regularization();
   c.normals = to_vec3s(r.normals());
   c.penalty = to_doubles(r.penalty());
   if (r.active()) c.active.assign(r.active()->begin(), r.active()->end());

@@ -87,9 +87,15 @@ void RemoteBeam::begin_step(int step, double time) {
   ch_.call("step_begin", [&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
 }
 
-SolveStats RemoteBeam::solve(const std::vector<Vec3>& q) {
+SolveStats RemoteBeam::solve(const std::vector<Vec3>& q) { return solve_(q, nullptr); }
+
+SolveStats RemoteBeam::solve_with_planes(const std::vector<Vec3>& q, const ContactPlanes& planes) {
+  return solve_(q, &planes);
+}
+
+SolveStats RemoteBeam::solve_(const std::vector<Vec3>& q, const ContactPlanes* planes) {
   auto b = ch_.call("solve", [&](const msg::Header& h) {
-    return msg::beam_solve_request(h, step_, iteration_, q);
+    return msg::beam_solve_request(h, step_, iteration_, q, planes);
   });
   const auto& r = reply_as<fb::BeamSolveReply>(b);
   account(ch_, r.stats());

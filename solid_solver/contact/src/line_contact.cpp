@@ -18,27 +18,35 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
   const int nn = num_nodes(kind);
   pc.proj = proj;
   pc.gap = proj.d - bp.R;
-  pc.active = pc.gap < 0.0;
+  const double g0 = par.regularization;
+  pc.active = pc.gap < g0;
   pc.q.setZero();
   pc.dq_dx.setZero();
   r.setZero(3 * nn);
   if (K) K->setZero(3 * nn, 3 * nn);
   if (!pc.active) return;
   const double eps = par.penalty, g = pc.gap, w = bp.w;
-  pc.q = -eps * g * proj.n;
+  // force magnitude f(g) = −dπ/dg and k(g) = −df/dg of the penalty law (linear, or linear-
+  // quadratic for g0 > 0); the linear law is the g0 → 0 limit: f = −eps g, k = eps.
+  double f = -eps * g, k = eps;
+  if (g0 > 0.0) {
+    f = g <= 0.0 ? eps * (0.5 * g0 - g) : 0.5 * eps * (g0 - g) * (g0 - g) / g0;
+    k = g <= 0.0 ? eps : eps * (g0 - g) / g0;
+  }
+  pc.q = f * proj.n;
   const bool need_h = K != nullptr || par.beam_tangent;
   GapLinearization L;
   linearize(kind, X, normal_sign, bp.x, proj, need_h, L);
-  // Pi = w eps/2 g^2 ; dPi/du = w eps g dd ; d2Pi/du2 = w eps (dd^T dd + g hd), u = [x, X]
+  // Pi = w pi(g); dPi/du = −w f dd; d2Pi/du2 = w (k dd^T dd − f hd), u = [x, X]
   const int m = L.m;
-  r = w * eps * g * L.dd.segment(3, m - 3).transpose();
+  r = -w * f * L.dd.segment(3, m - 3).transpose();
   if (K) {
     const Eigen::RowVectorXd dX = L.dd.segment(3, m - 3);
-    *K = w * eps * (dX.transpose() * dX + g * L.hd.bottomRightCorner(m - 3, m - 3));
+    *K = w * (k * dX.transpose() * dX - f * L.hd.bottomRightCorner(m - 3, m - 3));
   }
   if (par.beam_tangent) {
-    // q = -eps g n: dq/dx = -eps (n dd_x + g dn_x)
-    pc.dq_dx = -eps * (proj.n * L.dd.segment<3>(0) + g * L.dn.leftCols<3>());
+    // q = f n: dq/dx = −k n dd_x + f dn_x
+    pc.dq_dx = -k * proj.n * L.dd.segment<3>(0) + f * L.dn.leftCols<3>();
   }
 }
 
@@ -71,7 +79,12 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::
       res.force_on_beam += bp.w * pc.q;
       res.diag.force_on_solid -= bp.w * pc.q;
       res.diag.force_magnitude += bp.w * pc.q.norm();
-      res.diag.energy += 0.5 * bp.w * par.penalty * pc.gap * pc.gap;
+      {  // penalty potential π(g) of the law in line_point_kernel
+        const double g = pc.gap, g0 = par.regularization, e = par.penalty;
+        res.diag.energy += bp.w * (g0 <= 0.0 ? 0.5 * e * g * g
+                                   : g <= 0.0 ? e * (0.5 * g * g - 0.5 * g0 * g + g0 * g0 / 6.0)
+                                              : e * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0));
+      }
       nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + face.nn());
       nc.surface = static_cast<int>(k);
       nc.point = static_cast<int>(i);

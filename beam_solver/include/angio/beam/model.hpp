@@ -139,8 +139,18 @@ class BeamModel {
   double sample_weight(int g) const;
   double sample_radius(int g) const;
   void set_sample_line_loads(const std::vector<Vec3>& q);  // N/mm, one per sample point
+  // Robin mode: frozen contact planes per sample point (eps = 0: none), see plane_penalty.hpp.
+  // Their penalty loads are added to the sample line loads and linearized; empty: no planes.
+  struct SamplePlane {
+    Vec3 s = Vec3::Zero(), n = Vec3::Zero();
+    double eps = 0.0;
+    double g0 = 0.0;  // mm, regularization of the law (plane_penalty.hpp)
+  };
+  void set_sample_planes(std::vector<SamplePlane> planes);
+  // Sample line loads plus the planes' penalty loads at the current configuration (N/mm).
+  std::vector<Vec3> sample_contact_loads() const;
   const std::vector<Vec3>& sample_line_loads() const { return q_ext_; }
-  // Nodal forces consistent with the sample line loads (for output), N per node.
+  // Nodal forces consistent with sample_contact_loads() (for output), N per node.
   std::vector<Vec3> sample_load_nodal_forces() const;
 
   // Mean radial distance of the nodes from the axis, times 2.
@@ -181,6 +191,7 @@ class BeamModel {
   std::vector<double> mnorm_;
   std::vector<Vec6> stress_;
   std::vector<Vec3> q_ext_;
+  std::vector<SamplePlane> planes_;
   std::vector<Vec3> ref_radial_;  // reference radial direction per sample point
   std::vector<char> identity_basis_;
   SpMat pattern_;                 // sparsity pattern of the reduced tangent (built once)

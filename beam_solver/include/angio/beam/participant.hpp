@@ -21,6 +21,8 @@ class BeamSolverParticipant : public participant::BeamParticipant {
   participant::SamplePoints sample_points() const override;
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const std::vector<participant::Vec3>& line_loads) override;
+  participant::SolveStats solve_with_planes(const std::vector<participant::Vec3>& line_loads,
+                                            const participant::ContactPlanes& planes) override;
   void end_step(bool accept) override;
   void finish() override;
 
@@ -47,6 +49,7 @@ class BeamSolverParticipant : public participant::BeamParticipant {
   bool last_written_ = true;
   double initial_length_ = 0;
   void stent_measures(StepRecord& r, bool reference) const;
+  participant::SolveStats solve_loads_(const std::vector<participant::Vec3>& line_loads);
 };
 
 }  // namespace angio::beam

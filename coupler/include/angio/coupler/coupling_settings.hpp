@@ -1,8 +1,10 @@
 // The scene's `coupling:` section (DESIGN §2 "Coupling iteration").
 //   coupling:
-//     acceleration: aitken        # aitken | constant
+//     scheme: dirichlet-neumann   # dirichlet-neumann | robin (interface_scheme.hpp)
+//     acceleration: aitken        # aitken | iqn-ils | constant
 //     initial_relaxation: 0.5     # ω_0
-//     max_relaxation: 1.0         # cap on |ω|
+//     max_relaxation: 1.0         # cap on |ω| (aitken)
+//     iqn: {reused_steps: 8, max_columns: 100, filter: 1.0e-2}   # iqn-ils model (iqn_ils.hpp)
 //     max_iterations: 50
 //     rel_tol: 1.0e-4             # ||r|| <= rel_tol·||q~|| + abs_tol·sqrt(len)
 //     abs_tol: 1.0e-6             # N/mm
@@ -15,14 +17,17 @@
 #include <string>
 
 #include "angio/coupler/acceleration.hpp"
+#include "angio/coupler/iqn_ils.hpp"
 #include "angio/scene/node.hpp"
 
 namespace angio::coupler {
 
 struct CouplingSettings {
+  std::string scheme = "dirichlet-neumann";
   std::string acceleration = "aitken";
   double initial_relaxation = 0.5;
   double max_relaxation = 1.0;
+  IqnIlsOptions iqn;
   int max_iterations = 50;
   double rel_tol = 1e-4;
   double abs_tol = 1e-6;

@@ -18,8 +18,10 @@ Buffer hello(const Header& h, const std::string& software);
 Buffer hello_reply(const Header& h, const std::string& software,
                    const participant::SamplePoints* points /* beam only */);
 Buffer step_begin(const Header& h, std::uint32_t step, double time, double dt);
+// planes: robin mode (nullptr: plain Dirichlet–Neumann request)
 Buffer beam_solve_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                          const std::vector<participant::Vec3>& line_loads);
+                          const std::vector<participant::Vec3>& line_loads,
+                          const participant::ContactPlanes* planes = nullptr);
 Buffer beam_solve_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
                         const participant::SamplePoints& points);
 Buffer solid_solve_request(const Header& h, std::uint32_t step, std::uint32_t iteration,

@@ -17,6 +17,16 @@ class BeamParticipant {
   // Solves equilibrium with the external contact line loads (N/mm) at the sample points, in
   // addition to the scene's own loads, starting from the current iterate.
   virtual SolveStats solve(const std::vector<Vec3>& line_loads) = 0;
+  // Robin mode: as solve(), plus the penalty law of frozen contact planes at the sample points
+  // (types.hpp ContactPlanes), linearized inside the beam's own Newton. Participants that cannot
+  // do this keep this default, which reports a failed solve saying so.
+  virtual SolveStats solve_with_planes(const std::vector<Vec3>& line_loads, const ContactPlanes& planes) {
+    (void)line_loads;
+    (void)planes;
+    SolveStats s;
+    s.message = "this beam participant does not support the robin coupling mode (contact planes)";
+    return s;
+  }
   // accept: commit the plastic state and write output; reject: restore the last committed state.
   virtual void end_step(bool accept) = 0;
   // Close output files and write the summary.

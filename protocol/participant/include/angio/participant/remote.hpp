@@ -74,11 +74,14 @@ class RemoteBeam : public BeamParticipant {
   SamplePoints sample_points() const override { return points_; }
   void begin_step(int step, double time) override;
   SolveStats solve(const std::vector<Vec3>& line_loads) override;
+  SolveStats solve_with_planes(const std::vector<Vec3>& line_loads, const ContactPlanes& planes) override;
   void end_step(bool accept) override;
   void finish() override;  // sends Shutdown
   void set_iteration(int k) { iteration_ = k; }
 
  private:
+  SolveStats solve_(const std::vector<Vec3>& line_loads, const ContactPlanes* planes);
+
   Channel& ch_;
   SamplePoints points_;
   int step_ = 0, iteration_ = 0;

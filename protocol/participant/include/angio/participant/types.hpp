@@ -28,6 +28,16 @@ struct SolveStats {
   std::string message;  // why it failed, for the error report
 };
 
+// Robin mode (DESIGN §2): frozen contact planes per sample point, point s (mm), unit normal n
+// toward the beam and penalty eps (N/mm²; 0: no plane at this point). The beam adds the penalty
+// law q(x) = −eps·⟨(x − s)·n − R⟩·n of each plane to its loads and linearizes it in its Newton.
+struct ContactPlanes {
+  std::vector<Vec3> s, n;
+  std::vector<double> eps;
+  double g0 = 0.0;  // mm, regularization of the penalty law (plane_penalty.hpp), 0 = linear
+  std::size_t size() const { return eps.size(); }
+};
+
 // Solid → beam: the contact line loads q (N/mm) acting on the beam at each sample point, and for
 // the robin mode the active surface point s, its unit normal n (toward the beam) and penalty eps.
 struct ContactReply {
@@ -36,6 +46,7 @@ struct ContactReply {
   std::vector<Vec3> normals;
   std::vector<double> penalty;
   std::vector<std::uint8_t> active;
+  double regularization = 0.0;  // g0 (mm) of the solid's line penalty law, 0 = linear (Eq. 4)
   int n_active = 0;
   double min_gap = 0.0;  // most negative gap (largest penetration), mm
   Vec3 total_force{0.0, 0.0, 0.0};  // sum of w·q over the points (N)

@@ -22,6 +22,12 @@ struct BeamPoint {
 
 struct LineContactParams {
   double penalty = 10.0;         // eps (N/mm^2), paper value for stent-balloon and stent-artery
+  // g0 (mm): 0 = the paper's linear penalty law q = −eps⟨g⟩ (Eq. 4); g0 > 0 = the C¹
+  // "linear-quadratic" law of 4C's beam-to-solid contact: q = eps (g0/2 − g) for g ≤ 0,
+  // eps (g0 − g)²/(2 g0) for 0 < g < g0, 0 beyond. It removes the jump of the stiffness at
+  // g = 0 that makes Newton cycle when many points sit at the kink (shift of the contact
+  // surface: g0/2 at most).
+  double regularization = 0.0;
   bool compute_tangent = true;   // fill NodalContribution::K
   bool beam_tangent = false;     // fill PointContact::dq_dx
   ProjectionOptions projection;

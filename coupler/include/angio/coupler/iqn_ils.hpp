@@ -1,0 +1,52 @@
+// Interface quasi-Newton with an inverse Jacobian from a least-squares model (IQN-ILS;
+// Degroote, Bathe & Vierendeels 2009, Comput. Struct. 87, Eqs. 10–14; as in preCICE).
+// With H the fixed-point map q -> q~ and r = q~ − q, the differences of the iterates
+//   V = [r_k − r_{k−1}, …],  W = [q~_k − q~_{k−1}, …]
+// (of this step, then of up to `reused_steps` earlier accepted steps) give the update
+//   α = argmin ||V α + r_k||,   q_{k+1} = q~_k + W α.
+// Without any column (the very first iteration of a run) it relaxes: q_1 = q_0 + ω_0 r_0.
+// Unlike Aitken's single factor, the least-squares model resolves the individual unstable
+// interface modes (here: short-wave strut indentations of the balloon) and relaxes only them.
+// Columns that are nearly linearly dependent are dropped while the QR factorization is built
+// (filter: a column is kept if the part orthogonal to the kept ones exceeds `filter` times its
+// norm; the "QR2" filter of Haelterman et al. 2016).
+#pragma once
+
+#include <deque>
+#include <vector>
+
+#include "angio/coupler/acceleration.hpp"
+
+namespace angio::coupler {
+
+struct IqnIlsOptions {
+  double initial_relaxation = 0.5;  // ω_0 for the very first update
+  int reused_steps = 8;             // accepted steps whose columns stay in the model
+  int max_columns = 100;            // all columns together (newest kept)
+  double filter = 1e-2;             // QR2 filter threshold
+};
+
+class IqnIls : public Acceleration {
+ public:
+  explicit IqnIls(IqnIlsOptions o);
+  void begin_step() override;
+  Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) override;
+  void end_step(bool accepted) override;
+  double last_factor() const override { return factor_; }
+  std::string name() const override { return "iqn-ils"; }
+  // Columns used in the last update (after filtering), for logs and tests.
+  int last_columns() const { return last_columns_; }
+
+ private:
+  struct Columns {
+    std::vector<Eigen::VectorXd> v, w;  // newest first
+  };
+  IqnIlsOptions o_;
+  Columns current_;               // of the step in progress
+  std::deque<Columns> previous_;  // of earlier accepted steps, newest first
+  Eigen::VectorXd r_prev_, qt_prev_;
+  double factor_;
+  int last_columns_ = 0;
+};
+
+}  // namespace angio::coupler

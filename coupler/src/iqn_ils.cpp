@@ -1,0 +1,85 @@
+#include "angio/coupler/iqn_ils.hpp"
+
+#include <stdexcept>
+
+namespace angio::coupler {
+
+IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) {
+  if (!(o_.initial_relaxation > 0.0)) throw std::invalid_argument("IQN-ILS: initial relaxation must be > 0");
+  if (o_.reused_steps < 0 || o_.max_columns < 1 || !(o_.filter > 0.0 && o_.filter < 1.0))
+    throw std::invalid_argument("IQN-ILS: need reused_steps >= 0, max_columns >= 1, 0 < filter < 1");
+}
+
+void IqnIls::begin_step() {
+  current_ = Columns{};
+  r_prev_.resize(0);
+  qt_prev_.resize(0);
+}
+
+Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) {
+  const Eigen::VectorXd qt = q + r;
+  if (k > 0 && r_prev_.size() == r.size()) {
+    current_.v.insert(current_.v.begin(), r - r_prev_);
+    current_.w.insert(current_.w.begin(), qt - qt_prev_);
+  }
+  r_prev_ = r;
+  qt_prev_ = qt;
+
+  // Collect the columns, newest first, and orthogonalize them one by one (modified Gram–Schmidt
+  // with the QR2 filter); Q holds the kept orthonormal directions, R the triangular factor.
+  std::vector<const Eigen::VectorXd*> vs, ws;
+  auto take = [&](const Columns& c) {
+    for (std::size_t i = 0; i < c.v.size() && int(vs.size()) < o_.max_columns; ++i)
+      if (c.v[i].size() == r.size()) {
+        vs.push_back(&c.v[i]);
+        ws.push_back(&c.w[i]);
+      }
+  };
+  take(current_);
+  for (const auto& c : previous_) take(c);
+
+  std::vector<Eigen::VectorXd> Q;
+  std::vector<int> kept;
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(vs.size(), vs.size());
+  for (std::size_t j = 0; j < vs.size(); ++j) {
+    Eigen::VectorXd v = *vs[j];
+    const double norm0 = v.norm();
+    if (!(norm0 > 0.0)) continue;
+    Eigen::VectorXd coeff(Q.size());
+    for (std::size_t i = 0; i < Q.size(); ++i) {
+      coeff[i] = Q[i].dot(v);
+      v -= coeff[i] * Q[i];
+    }
+    const double rest = v.norm();
+    if (rest < o_.filter * norm0) continue;  // (nearly) dependent on newer columns: drop
+    const std::size_t c = Q.size();
+    for (std::size_t i = 0; i < c; ++i) R(i, c) = coeff[i];
+    R(c, c) = rest;
+    Q.push_back(v / rest);
+    kept.push_back(int(j));
+  }
+  last_columns_ = int(Q.size());
+  if (Q.empty()) {
+    factor_ = o_.initial_relaxation;
+    return q + factor_ * r;
+  }
+  // α = argmin ||V α + r||  ⇔  R α = −Qᵀ r
+  const int m = int(Q.size());
+  Eigen::VectorXd rhs(m);
+  for (int i = 0; i < m; ++i) rhs[i] = -Q[i].dot(r);
+  const Eigen::VectorXd alpha = R.topLeftCorner(m, m).triangularView<Eigen::Upper>().solve(rhs);
+  Eigen::VectorXd next = qt;
+  for (int i = 0; i < m; ++i) next += alpha[i] * *ws[kept[i]];
+  factor_ = 1.0;
+  return next;
+}
+
+void IqnIls::end_step(bool accepted) {
+  if (accepted && o_.reused_steps > 0 && !current_.v.empty()) {
+    previous_.push_front(std::move(current_));
+    while (int(previous_.size()) > o_.reused_steps) previous_.pop_back();
+  }
+  current_ = Columns{};
+}
+
+}  // namespace angio::coupler
