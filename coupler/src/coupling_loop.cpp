@@ -1,26 +1,17 @@
 #include "angio/coupler/coupling_loop.hpp"
 
-#include <chrono>
 #include <cmath>
-#include <sstream>
 
+#include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 #include "angio/coupler/interface_scheme.hpp"
 
 namespace angio::coupler {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-std::string history(const std::vector<double>& h) {
-  std::ostringstream os;
-  os << "[";
-  for (std::size_t i = 0; i < h.size(); ++i) os << (i ? ", " : "") << h[i];
-  return os.str() + "]";
+std::string newton_failure(const char* who, int k, const participant::SolveStats& s) {
+  return std::string(who) + " Newton failed in coupling iteration " + std::to_string(k) + ": " +
+         s.message + ", residual history " + log::list(s.residual_history);
 }
 
 }  // namespace
@@ -52,21 +43,19 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     for (int k = 0; k < settings.max_iterations; ++k) {
       auto t0 = Clock::now();
       participant::SolveStats bs = scheme->solve_beam(beam);
-      rep.beam_time += since(t0);
+      rep.beam_time += seconds_since(t0);
       if (!bs.converged) {
         participant_failed = true;
-        failure = "beam Newton failed in coupling iteration " + std::to_string(k) + ": " +
-                  bs.message + ", residual history " + history(bs.residual_history);
+        failure = newton_failure("beam", k, bs);
         break;
       }
       rep.beam_points = beam.sample_points();
       t0 = Clock::now();
       participant::SolveStats ss = solid.solve(rep.beam_points, rep.contact);  // positions in
-      rep.solid_time += since(t0);
+      rep.solid_time += seconds_since(t0);
       if (!ss.converged) {
         participant_failed = true;
-        failure = "solid Newton failed in coupling iteration " + std::to_string(k) + ": " +
-                  ss.message + ", residual history " + history(ss.residual_history);
+        failure = newton_failure("solid", k, ss);
         break;
       }
       const auto& reply = rep.contact;
@@ -100,7 +89,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     if (!accept) {
       if (!participant_failed)
         failure = "coupling did not converge in " + std::to_string(settings.max_iterations) +
-                  " iterations, residual history " + history(rep.residuals);
+                  " iterations, residual history " + log::list(rep.residuals);
       LOG_WARN("step " << rep.step << " t = " << rep.time << " s rejected: " << failure
                        << "; cutting the step");
       beam.end_step(false);
@@ -120,7 +109,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     acc.end_step(true);
     scheme->accept(stepper.increment());
     rep.omega = acc.last_factor();
-    rep.wall_time = since(step_start);
+    rep.wall_time = seconds_since(step_start);
     run.steps++;
     run.total_iterations += rep.iterations;
     run.max_iterations = std::max(run.max_iterations, rep.iterations);
@@ -130,7 +119,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     stepper.accept();
     step_start = Clock::now();
   }
-  run.wall_time = since(run_start);
+  run.wall_time = seconds_since(run_start);
   return run;
 }
 

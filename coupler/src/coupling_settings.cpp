@@ -1,10 +1,6 @@
 #include "angio/coupler/coupling_settings.hpp"
 
-#include <stdexcept>
-
 #include "angio/coupler/aitken.hpp"
-#include "angio/coupler/dirichlet_neumann.hpp"
-#include "angio/coupler/robin.hpp"
 
 namespace angio::coupler {
 
@@ -38,12 +34,6 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   s.prediction = c->choice_or("prediction", {"constant", "extrapolate"}, s.prediction);
   s.record = c->boolean_or("record", s.record);
   return s;
-}
-
-std::unique_ptr<InterfaceScheme> make_interface_scheme(const std::string& name, std::size_t n_points) {
-  if (name == "robin") return std::make_unique<Robin>(n_points);
-  if (name == "dirichlet-neumann") return std::make_unique<DirichletNeumann>(n_points);
-  throw std::invalid_argument("unknown coupling scheme '" + name + "' (dirichlet-neumann | robin)");
 }
 
 std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s) {

@@ -1,5 +1,6 @@
-// coupler: owns the load steps and the Dirichlet–Neumann coupling iteration of a run; talks to
-// beam_solver and solid_solver over zenoh and never touches element data (DESIGN §2).
+// coupler: owns the load steps and the coupling iteration of a run (Dirichlet–Neumann or robin,
+// coupling_loop.hpp); talks to beam_solver and solid_solver over zenoh and never touches element
+// data (DESIGN §2).
 #include <chrono>
 #include <functional>
 #include <filesystem>
@@ -33,7 +34,7 @@ void write_summary(const fs::path& path, const std::string& status, const std::s
     << "  \"rejected_attempts\": " << run.rejected_attempts << ",\n"
     << "  \"coupling_iterations_total\": " << run.total_iterations << ",\n"
     << "  \"coupling_iterations_mean\": "
-    << (run.steps ? double(run.total_iterations) / run.steps : 0.0) << ",\n"
+    << run.mean_iterations() << ",\n"
     << "  \"coupling_iterations_max\": " << run.max_iterations << ",\n"
     << "  \"wall_time\": " << run.wall_time << ",\n"
     << "  \"beam_time\": " << run.beam_time << ",\n"
@@ -121,7 +122,7 @@ int run(const cli::Parser& args) {
   const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
   write_summary(run_dir / "coupling_summary.json", "ok", "", report, messaging);
   LOG_INFO("done: " << report.steps << " steps, coupling iterations mean "
-                    << (report.steps ? double(report.total_iterations) / report.steps : 0.0)
+                    << report.mean_iterations()
                     << " max " << report.max_iterations << ", wall " << report.wall_time
                     << " s, messaging " << 100.0 * messaging / std::max(report.wall_time, 1e-12)
                     << " %");
@@ -132,24 +133,14 @@ int run(const cli::Parser& args) {
 
 int main(int argc, char** argv) {
   cli::Parser args("coupler",
-                   "Runs the load steps and the Dirichlet-Neumann coupling iterations (Aitken) of a\n"
-                   "co-simulation; beam_solver and solid_solver connect to --endpoint.");
+                   "Runs the load steps and the coupling iterations (scene coupling.scheme and\n"
+                   "coupling.acceleration) of a co-simulation; beam_solver and solid_solver connect\n"
+                   "to --endpoint.");
   args.add_common();
   args.add({"record", "", "record every exchanged message into <run-dir>/exchanges.angiorec", ""});
-  try {
-    if (!args.parse(argc, argv)) return 0;
+  return cli::run_main(args, argc, argv, [&] {
     cli::setup_logging(args, "coupler");
-    if (!args.has("scene")) throw cli::UsageError("missing required option --scene (see --help)");
-    if (!args.has("endpoint")) throw cli::UsageError("missing required option --endpoint (see --help)");
+    cli::require(args, {"scene", "endpoint"});
     return run(args);
-  } catch (const cli::UsageError& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  } catch (const scene::SceneError& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    LOG_ERROR(e.what());
-    return 1;
-  }
+  });
 }

@@ -15,8 +15,7 @@ int main(int argc, char** argv) {
   args.add({"role", "ROLE", "beam or solid", ""});
   args.add({"delay", "SECONDS", "sleep this long in every solve (to test interruption)", "0"});
   args.add_common();
-  try {
-    if (!args.parse(argc, argv)) return 0;
+  return cli::run_main(args, argc, argv, [&] {
     const std::string role = args.get("role");
     cli::setup_logging(args, "spring-" + role);
     const participant::ServeOptions o = participant::serve_options(args, "spring_participant");
@@ -28,8 +27,5 @@ int main(int argc, char** argv) {
     }
     test::WallSolid wall;
     return participant::serve(wall, o);
-  } catch (const std::exception& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  }
+  });
 }

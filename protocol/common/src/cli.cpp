@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "angio/common/log.hpp"
+#include "angio/scene/node.hpp"
 
 namespace angio::cli {
 
@@ -103,6 +104,31 @@ void setup_logging(const Parser& p, const std::string& role) {
     log::set_level(log::parse_level(p.get("log-level")));
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--log-level: ") + e.what());
+  }
+}
+
+void require(const Parser& p, std::initializer_list<const char*> names) {
+  for (const char* n : names)
+    if (!p.has(n) || p.get(n).empty())
+      throw UsageError(std::string("missing required option --") + n + " (see --help)");
+}
+
+int run_main(Parser& p, int argc, char** argv, const std::function<int()>& body) {
+  try {
+    if (!p.parse(argc, argv)) return 0;
+    return body();
+  } catch (const UsageError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const scene::SceneError& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    LOG_ERROR(e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    LOG_ERROR(e.what());
+    return 1;
   }
 }
 

@@ -42,4 +42,11 @@ void write(Level level, const std::string& message) {
   std::fflush(out);
 }
 
+std::string list(const std::vector<double>& values) {
+  std::ostringstream os;
+  os << "[";
+  for (std::size_t i = 0; i < values.size(); ++i) os << (i ? ", " : "") << values[i];
+  return os.str() + "]";
+}
+
 }  // namespace angio::log

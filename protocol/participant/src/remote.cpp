@@ -1,5 +1,6 @@
 #include "angio/participant/remote.hpp"
 
+#include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 #include "angio/messages/builders.hpp"
 #include "angio/messages/convert.hpp"
@@ -10,7 +11,6 @@
 namespace angio::participant {
 
 namespace {
-using Clock = std::chrono::steady_clock;
 }  // namespace
 
 Channel::Channel(const transport::Session& session, std::string run_id, fb::Role role,
@@ -38,7 +38,7 @@ msg::Buffer Channel::call(const std::string& verb, const Build& build) {
                                   "' within " + std::to_string(timeout_.count() / 1000.0) +
                                   " s (is it running? see its log): " + e.what());
   }
-  timing_.round_trip = std::chrono::duration<double>(Clock::now() - t0).count();
+  timing_.round_trip = seconds_since(t0);
   timing_.solver_time = 0.0;
   if (recorder_) recorder_->add(role_, verb, request, reply);
   const fb::Envelope* env = nullptr;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <functional>
 
+#include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 #include "angio/messages/builders.hpp"
 #include "angio/messages/convert.hpp"
@@ -12,14 +13,8 @@
 namespace angio::participant {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 // Turns one verified request into a reply; sets `stop` after a Shutdown.
 using Dispatch = std::function<msg::Buffer(const fb::Envelope&, const msg::Header&, bool& stop)>;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // The loop shared by every role: receive, verify, check the sequence, dispatch, reply; watch the
 // coupler's liveliness token and the silence timeout so that a vanished coupler ends the process

@@ -2,22 +2,15 @@
 
 #include <chrono>
 #include <functional>
-#include <sstream>
 
+#include "angio/common/clock.hpp"
 #include "angio/common/load_stepper.hpp"
 #include "angio/common/log.hpp"
 
 namespace angio::participant {
 namespace {
 
-std::string history(const SolveStats& s) {
-  std::ostringstream os;
-  os << "residual history [";
-  for (std::size_t i = 0; i < s.residual_history.size(); ++i)
-    os << (i ? ", " : "") << s.residual_history[i];
-  os << "]";
-  return os.str();
-}
+std::string history(const SolveStats& s) { return "residual history " + log::list(s.residual_history); }
 
 // The loop is the same for both roles; only the solve call differs.
 int run(const scene::TimeSettings& time, const std::function<void(int, double)>& begin,
@@ -26,7 +19,7 @@ int run(const scene::TimeSettings& time, const std::function<void(int, double)>&
   LoadStepper stepper(time);
   try {
     while (!stepper.finished()) {
-      const auto t0 = std::chrono::steady_clock::now();
+      const auto t0 = Clock::now();
       begin(stepper.step(), stepper.time());
       SolveStats s = solve();
       if (!s.converged) {
@@ -39,7 +32,7 @@ int run(const scene::TimeSettings& time, const std::function<void(int, double)>&
       }
       end(true);
       const double wall =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          seconds_since(t0);
       // The participant logs its own line per committed step (with its physical measures).
       LOG_DEBUG("step " << stepper.step() << " t = " << stepper.time() << " s: " << s.iterations
                        << " Newton iterations, residual " << s.residual << ", " << wall << " s");

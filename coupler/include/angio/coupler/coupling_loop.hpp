@@ -34,6 +34,7 @@ struct StepReport {
 struct RunReport {
   int steps = 0;
   int total_iterations = 0;
+  double mean_iterations() const { return steps ? double(total_iterations) / steps : 0.0; }
   int max_iterations = 0;
   int rejected_attempts = 0;
   double wall_time = 0.0;

@@ -19,8 +19,6 @@
 
 namespace angio::coupler {
 
-struct CouplingSettings;
-
 class InterfaceScheme {
  public:
   virtual ~InterfaceScheme() = default;

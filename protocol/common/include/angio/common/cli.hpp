@@ -2,6 +2,8 @@
 // flags: --scene FILE, --run-dir DIR, --endpoint E, --run-id ID, --timeout S, --log-level L.
 #pragma once
 
+#include <functional>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -45,5 +47,14 @@ class Parser {
 
 // Applies --log-level and names the role in every log line.
 void setup_logging(const Parser& p, const std::string& role);
+
+// Throws UsageError "missing required option --NAME (see --help)" for the first option of
+// `names` that was not given (or given empty).
+void require(const Parser& p, std::initializer_list<const char*> names);
+
+// The shape every executable's main() shares: parses the command line (--help → exit 0), runs
+// `body` and maps failures to exit codes, each logged once: usage errors, scene errors and
+// invalid arguments → 2 (bad input), any other exception → 1. Returns body's exit code otherwise.
+int run_main(Parser& p, int argc, char** argv, const std::function<int()>& body);
 
 }  // namespace angio::cli

@@ -4,6 +4,7 @@
 
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace angio::log {
 
@@ -16,6 +17,9 @@ Level parse_level(const std::string& name);  // "debug", "info", "warn", "error"
 void write(Level level, const std::string& message);
 
 inline bool enabled(Level l) { return static_cast<int>(l) >= static_cast<int>(level()); }
+
+// "[a, b, c]": residual histories and similar lists in error reports.
+std::string list(const std::vector<double>& values);
 
 }  // namespace angio::log
 
