@@ -33,6 +33,8 @@ def main():
     end, steps = float(m.group(1)), int(m.group(2))
     new_end = end * a.steps / steps
     text = text.replace(m.group(0), f"time: {{end: {new_end}, steps: {a.steps}}}")
+    if not re.search(r"petsc_options:", text):
+        sys.exit("scene needs a 'petsc_options:' line (solid section) for the solver options to vary")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     print(f"{'ranks':>5} {'solver':<22} {'newton its':>10} {'s/iteration':>12} {'total s':>8}")
     for ranks in a.ranks:

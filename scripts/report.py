@@ -11,10 +11,13 @@ import json
 import sys
 from pathlib import Path
 
-import matplotlib
+try:  # plots are optional: without matplotlib the table and results.json are still written
+    import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError:
+    plt = None
 
 # Paper values (DESIGN §4) for the straight free expansion, shown next to ours.
 PAPER = {"diameter_initial": 1.15, "diameter_max": 2.59, "diameter_final": 2.31,
@@ -27,6 +30,20 @@ def load_json(p):
             return json.load(f)
     except (OSError, json.JSONDecodeError):
         return None
+
+
+def plot(path, x, y, xlabel, ylabel):
+    if plt is None:
+        print(f"report: matplotlib not available to {sys.executable}; {path.name} not written")
+        return
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(x, y, "o-", ms=3)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 def main(run_dir):
@@ -81,27 +98,14 @@ def main(run_dir):
     if beam and beam.get("steps"):
         t = [0.0] + [s["time"] for s in beam["steps"]]
         D = [beam["diameter"]["initial"]] + [s["diameter"] for s in beam["steps"]]
-        fig, ax = plt.subplots(figsize=(6, 4))
-        ax.plot(t, D, "o-", ms=3)
-        ax.set_xlabel("pseudo-time t (s)")
-        ax.set_ylabel("stent diameter (mm)")
-        ax.grid(True, alpha=0.3)
-        fig.tight_layout()
-        fig.savefig(run / "diameter_vs_time.png", dpi=120)
-        plt.close(fig)
+        plot(run / "diameter_vs_time.png", t, D, "pseudo-time t (s)", "stent diameter (mm)")
         if steps_csv:
             p_of_t = {round(float(r["time"]), 9): float(r["pressure"]) for r in steps_csv}
             pts = [(p_of_t[round(s["time"], 9)] / 0.101325, s["diameter"]) for s in beam["steps"]
                    if round(s["time"], 9) in p_of_t]
             if pts:
-                fig, ax = plt.subplots(figsize=(6, 4))
-                ax.plot([p for p, _ in pts], [d for _, d in pts], "o-", ms=3)
-                ax.set_xlabel("balloon pressure (atm)")
-                ax.set_ylabel("stent diameter (mm)")
-                ax.grid(True, alpha=0.3)
-                fig.tight_layout()
-                fig.savefig(run / "diameter_vs_pressure.png", dpi=120)
-                plt.close(fig)
+                plot(run / "diameter_vs_pressure.png", [p for p, _ in pts], [d for _, d in pts],
+                     "balloon pressure (atm)", "stent diameter (mm)")
     print(f"report: {run / 'results.json'}" + (" and plots" if beam else ""))
 
 

@@ -12,6 +12,7 @@
 """
 import json
 import os
+import struct
 import subprocess
 import sys
 import tempfile
@@ -51,8 +52,13 @@ with tempfile.TemporaryDirectory() as tmp:
         check((tmp / "real" / "beam" / "summary.json").is_file(), "beam summary written")
         check((tmp / "real" / "solid" / "summary.json").is_file(), "solid summary written")
 
-    rec_id = None
     if REC.is_file():
+        # The recorded run id (header: 8-byte magic, u32 format, u32 length + id): the real
+        # solvers must serve under it for the driver's requests to reach them.
+        with open(REC, "rb") as f:
+            f.read(12)
+            rec_id = f.read(struct.unpack("<I", f.read(4))[0]).decode()
+
         # 2a. coupler + replay participants
         replay = str(BIN / "replay_participant")
         r = run(LAUNCH + [str(SCENE), "--run-dir", str(tmp / "replay"), "--build-dir", str(BIN.parent), "--timeout", "60",
@@ -66,9 +72,6 @@ with tempfile.TemporaryDirectory() as tmp:
             driver = subprocess.Popen([str(BIN / "replay_driver"), "--recording", str(REC), "--role", role,
                                        "--endpoint", ep, "--tolerance", TOL_SOLVER, "--timeout", "120"],
                                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            rec_id = rec_id or subprocess.run(
-                [sys.executable, "-c", f"import struct;f=open('{REC}','rb');f.read(12);n=struct.unpack('<I',f.read(4))[0];print(f.read(n).decode())"],
-                capture_output=True, text=True).stdout.strip()
             solver = run(exe + ["--scene", str(SCENE), "--run-dir", str(tmp / f"drive_{role}"), "--endpoint", ep,
                                 "--run-id", rec_id, "--timeout", "60"], timeout=300)
             out, _ = driver.communicate(timeout=120)

@@ -14,8 +14,7 @@ using Clock = std::chrono::steady_clock;
 TEST(TransportLiveliness, DroppedTokenIsSeenGone) {
   tt::TempDir dir;
   const std::string key = tt::unique_prefix("live") + "/beam/alive";
-  auto watcher_session = at::Session::open({.listen = {dir.unix_endpoint()}, .connect = {}});
-  auto peer = at::Session::open({.listen = {}, .connect = {dir.unix_endpoint()}});
+  auto [watcher_session, peer] = tt::linked_sessions(dir.unix_endpoint());
   auto watcher = watcher_session.watch_liveliness(key);
   {
     auto token = peer.declare_liveliness_token(key);

@@ -13,8 +13,7 @@ using namespace std::chrono_literals;
 TEST(TransportPubSub, StatusLineReachesWildcardSubscriber) {
   tt::TempDir dir;
   const std::string prefix = tt::unique_prefix("status");
-  auto a = at::Session::open({.listen = {dir.unix_endpoint()}, .connect = {}});
-  auto b = at::Session::open({.listen = {}, .connect = {dir.unix_endpoint()}});
+  auto [a, b] = tt::linked_sessions(dir.unix_endpoint());
   auto sub = a.declare_subscriber(prefix + "/*/status");
   auto pub = b.declare_publisher(prefix + "/beam/status");
 

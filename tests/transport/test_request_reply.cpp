@@ -39,8 +39,7 @@ at::Bytes reversed(at::ByteView v) { return at::Bytes(v.rbegin(), v.rend()); }
 
 void exchange_small_and_large(const std::string& endpoint) {
   const std::string key = tt::unique_prefix("rr") + "/coupler/step";
-  auto server = at::Session::open({.listen = {endpoint}, .connect = {}});
-  auto client = at::Session::open({.listen = {}, .connect = {endpoint}});
+  auto [server, client] = tt::linked_sessions(endpoint);
   auto queryable = server.declare_queryable(key);
   BackgroundServer bg(queryable, [](const at::IncomingQuery& q) { return reversed(q.payload()); });
 
@@ -75,8 +74,7 @@ TEST(TransportRequestReply, TcpLoopbackSmallAndLargePayloads) {
 TEST(TransportRequestReply, HandlerExceptionBecomesRemoteError) {
   tt::TempDir dir;
   const std::string key = tt::unique_prefix("err") + "/coupler/step";
-  auto server = at::Session::open({.listen = {dir.unix_endpoint()}, .connect = {}});
-  auto client = at::Session::open({.listen = {}, .connect = {dir.unix_endpoint()}});
+  auto [server, client] = tt::linked_sessions(dir.unix_endpoint());
   auto queryable = server.declare_queryable(key);
   BackgroundServer bg(queryable, [](const at::IncomingQuery&) -> at::Bytes {
     throw std::runtime_error("bad step index");
@@ -92,8 +90,7 @@ TEST(TransportRequestReply, HandlerExceptionBecomesRemoteError) {
 TEST(TransportRequestReply, ManualRecvAndReplyExposeKey) {
   tt::TempDir dir;
   const std::string key = tt::unique_prefix("manual") + "/beam/forces";
-  auto server = at::Session::open({.listen = {dir.unix_endpoint()}, .connect = {}});
-  auto client = at::Session::open({.listen = {}, .connect = {dir.unix_endpoint()}});
+  auto [server, client] = tt::linked_sessions(dir.unix_endpoint());
   auto queryable = server.declare_queryable(key);
   std::thread t([&] {
     const auto deadline = std::chrono::steady_clock::now() + 30s;

@@ -53,8 +53,7 @@ TEST(TransportTimeout, PeerNeverStarted) {
 TEST(TransportTimeout, QueryableThatNeverAnswers) {
   tt::TempDir dir;
   const std::string key = tt::unique_prefix("silent") + "/coupler/step";
-  auto server = at::Session::open({.listen = {dir.unix_endpoint()}, .connect = {}});
-  auto client = at::Session::open({.listen = {}, .connect = {dir.unix_endpoint()}});
+  auto [server, client] = tt::linked_sessions(dir.unix_endpoint());
   auto queryable = server.declare_queryable(key);
   // The first query is answered so that the route is known to exist; the second is held
   // unanswered, so its timeout is of the "did not answer" kind.

@@ -50,6 +50,11 @@ std::string free_tcp_endpoint() {
   return "tcp/127.0.0.1:" + std::to_string(port);
 }
 
+std::pair<Session, Session> linked_sessions(const std::string& endpoint) {
+  auto listener = Session::open({.listen = {endpoint}, .connect = {}});
+  return {std::move(listener), Session::open({.listen = {}, .connect = {endpoint}})};
+}
+
 std::string unique_prefix(const std::string& test_name) {
   static std::atomic<int> counter{0};
   return "angio/test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "/" + test_name;

@@ -5,7 +5,10 @@
 #include <chrono>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "angio/transport/session.hpp"
 
 namespace angio::transport::test {
 
@@ -26,6 +29,10 @@ class TempDir {
 
 // A tcp endpoint on 127.0.0.1 with a port that was free a moment ago.
 std::string free_tcp_endpoint();
+
+// Two sessions of this process linked through `endpoint`: the first listens on it, the second
+// connects to it.
+std::pair<Session, Session> linked_sessions(const std::string& endpoint);
 
 // Unique key prefix so concurrent test runs never see each other's keys.
 std::string unique_prefix(const std::string& test_name);

@@ -1,9 +1,9 @@
 // replay_driver: plays the coupler for ONE real participant. It sends the recorded requests of
 // that role verbatim and compares the participant's replies with the recorded replies within a
 // tolerance (the check that a solver still reproduces a recorded co-simulation).
+#include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <iostream>
+#include <string>
 
 #include "angio/common/cli.hpp"
 #include "angio/common/log.hpp"
@@ -15,18 +15,6 @@
 using namespace angio;
 
 namespace {
-
-std::string verb_of(fb::Payload p) {
-  switch (p) {
-    case fb::Payload::Hello: return "hello";
-    case fb::Payload::StepBegin: return "step_begin";
-    case fb::Payload::BeamSolveRequest:
-    case fb::Payload::SolidSolveRequest: return "solve";
-    case fb::Payload::StepEnd: return "step_end";
-    case fb::Payload::Shutdown: return "shutdown";
-    default: return "unknown";
-  }
-}
 
 // Relative deviation of a live reply from the recorded one, on the interface vectors the
 // coupler consumes; throws if the kind of reply differs.
@@ -60,8 +48,7 @@ int main(int argc, char** argv) {
   args.add({"role", "ROLE", "beam or solid", ""});
   args.add({"tolerance", "REL", "relative tolerance on interface vectors", "1e-6"});
   args.add_common();
-  try {
-    if (!args.parse(argc, argv)) return 0;
+  return cli::run_main(args, argc, argv, [&] {
     cli::setup_logging(args, "replay-driver");
     const std::string role = args.get("role");
     const fb::Role r = replay::role_from_name(role);
@@ -74,8 +61,8 @@ int main(int argc, char** argv) {
     std::size_t n = 0;
     for (const auto& e : rec.exchanges) {
       if (e.role != r) continue;
-      const fb::Envelope& req = msg::open(e.request, rec.run_id);
-      const std::string key = participant::keys::request(rec.run_id, role, verb_of(req.payload_type()));
+      // The recording keeps the verb the coupler sent the request to.
+      const std::string key = participant::keys::request(rec.run_id, role, e.verb);
       const auto live_bytes = session.request(key, e.request, timeout);
       const fb::Envelope& live = msg::open(live_bytes, rec.run_id);
       if (const auto* err = live.payload_as_Error())
@@ -84,7 +71,7 @@ int main(int argc, char** argv) {
       const double d = deviation(live, msg::open(e.reply, rec.run_id));
       worst = std::max(worst, d);
       if (!(d <= tol))
-        throw replay::ReplayMismatch("exchange " + std::to_string(n) + " (" + verb_of(req.payload_type()) +
+        throw replay::ReplayMismatch("exchange " + std::to_string(n) + " (" + e.verb +
                                      "): reply deviates by " + std::to_string(d) +
                                      " (relative), tolerance " + std::to_string(tol));
       ++n;
@@ -92,14 +79,5 @@ int main(int argc, char** argv) {
     LOG_INFO(n << " exchanges replayed against the " << role << " participant; largest relative deviation "
                << worst << " (tolerance " << tol << ")");
     return 0;
-  } catch (const cli::UsageError& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    LOG_ERROR(e.what());
-    return 1;
-  }
+  });
 }

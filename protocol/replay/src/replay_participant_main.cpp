@@ -3,7 +3,6 @@
 #include <chrono>
 
 #include "angio/common/cli.hpp"
-#include "angio/common/log.hpp"
 #include "angio/participant/role_server.hpp"
 #include "angio/replay/replay_participants.hpp"
 
@@ -17,8 +16,7 @@ int main(int argc, char** argv) {
   args.add({"role", "ROLE", "beam or solid", ""});
   args.add({"tolerance", "REL", "relative tolerance on interface vectors", "1e-9"});
   args.add_common();
-  try {
-    if (!args.parse(argc, argv)) return 0;
+  return cli::run_main(args, argc, argv, [&] {
     const std::string role = args.get("role");
     cli::setup_logging(args, "replay-" + role);
     const fb::Role r = replay::role_from_name(role);
@@ -33,14 +31,5 @@ int main(int argc, char** argv) {
     }
     replay::ReplaySolid solid(rec, tol);
     return participant::serve(solid, o);
-  } catch (const cli::UsageError& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    LOG_ERROR(e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    LOG_ERROR(e.what());
-    return 1;
-  }
+  });
 }

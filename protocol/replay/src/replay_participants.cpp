@@ -20,27 +20,21 @@ Cursor::Cursor(const recording::Recording& rec, fb::Role role) : run_id_(rec.run
   // The handshake is answered from the recording at construction time by the participants.
 }
 
-const fb::Envelope& Cursor::request(const recording::Exchange& e) const {
-  return msg::open(e.request, run_id_);
-}
-const fb::Envelope& Cursor::reply(const recording::Exchange& e) const {
-  return msg::open(e.reply, run_id_);
-}
-
-const recording::Exchange& Cursor::next(fb::Payload expected) {
+const fb::Envelope& Cursor::next(fb::Payload expected) {
   if (pos_ >= items_.size())
     throw ReplayMismatch(std::string("received a ") + msg::payload_name(expected) +
                          " request after the end of the recording (" + std::to_string(items_.size()) +
                          " exchanges of role " + msg::role_name(role_) + ")");
-  const recording::Exchange& e = *items_[pos_];
-  const fb::Envelope& req = request(e);
+  const fb::Envelope& req = msg::open(items_[pos_]->request, run_id_);
   if (req.payload_type() != expected)
     throw ReplayMismatch("exchange " + std::to_string(pos_) + " of role " + msg::role_name(role_) +
                          ": received a " + msg::payload_name(expected) + " request, recorded a " +
                          msg::payload_name(req.payload_type()));
   ++pos_;
-  return e;
+  return req;
 }
+
+const fb::Envelope& Cursor::reply() const { return msg::open(items_.at(pos_ - 1)->reply, run_id_); }
 
 double relative_difference(const std::vector<participant::Vec3>& a,
                            const std::vector<participant::Vec3>& b) {
@@ -88,27 +82,24 @@ void check_vectors(const Cursor& c, const char* what, const std::vector<particip
 
 ReplayBeam::ReplayBeam(const recording::Recording& rec, double tol)
     : cursor_(rec, fb::Role::Beam), tol_(tol) {
-  const auto& e = cursor_.next(fb::Payload::Hello);
-  points_ = msg::to_sample_points(msg::payload_as<fb::HelloReply>(cursor_.reply(e)).sample_points());
+  cursor_.next(fb::Payload::Hello);
+  points_ = msg::to_sample_points(msg::payload_as<fb::HelloReply>(cursor_.reply()).sample_points());
 }
 
 void ReplayBeam::begin_step(int step, double time) {
-  const auto& e = cursor_.next(fb::Payload::StepBegin);
-  check_step(cursor_, *cursor_.request(e).payload_as_StepBegin(), step, time);
+  check_step(cursor_, *cursor_.next(fb::Payload::StepBegin).payload_as_StepBegin(), step, time);
 }
 
 participant::SolveStats ReplayBeam::solve(const std::vector<participant::Vec3>& q) {
-  const auto& e = cursor_.next(fb::Payload::BeamSolveRequest);
-  check_vectors(cursor_, "beam line loads",
-                q, msg::to_vec3s(cursor_.request(e).payload_as_BeamSolveRequest()->line_loads()), tol_);
-  const auto& r = msg::payload_as<fb::BeamSolveReply>(cursor_.reply(e));
+  const auto& req = *cursor_.next(fb::Payload::BeamSolveRequest).payload_as_BeamSolveRequest();
+  check_vectors(cursor_, "beam line loads", q, msg::to_vec3s(req.line_loads()), tol_);
+  const auto& r = msg::payload_as<fb::BeamSolveReply>(cursor_.reply());
   points_ = msg::to_sample_points(r.sample_points());
   return msg::to_stats(r.stats());
 }
 
 void ReplayBeam::end_step(bool accept) {
-  const auto& e = cursor_.next(fb::Payload::StepEnd);
-  check_end(cursor_, *cursor_.request(e).payload_as_StepEnd(), accept);
+  check_end(cursor_, *cursor_.next(fb::Payload::StepEnd).payload_as_StepEnd(), accept);
 }
 
 void ReplayBeam::finish() { cursor_.next(fb::Payload::Shutdown); }
@@ -119,23 +110,20 @@ ReplaySolid::ReplaySolid(const recording::Recording& rec, double tol)
 }
 
 void ReplaySolid::begin_step(int step, double time) {
-  const auto& e = cursor_.next(fb::Payload::StepBegin);
-  check_step(cursor_, *cursor_.request(e).payload_as_StepBegin(), step, time);
+  check_step(cursor_, *cursor_.next(fb::Payload::StepBegin).payload_as_StepBegin(), step, time);
 }
 
 participant::SolveStats ReplaySolid::solve(const participant::SamplePoints& pts,
                                            participant::ContactReply& reply) {
-  const auto& e = cursor_.next(fb::Payload::SolidSolveRequest);
-  auto rec = msg::to_sample_points(cursor_.request(e).payload_as_SolidSolveRequest()->sample_points());
-  check_vectors(cursor_, "sample-point positions", pts.x, rec.x, tol_);
-  const auto& r = msg::payload_as<fb::SolidSolveReply>(cursor_.reply(e));
+  const auto& req = *cursor_.next(fb::Payload::SolidSolveRequest).payload_as_SolidSolveRequest();
+  check_vectors(cursor_, "sample-point positions", pts.x, msg::to_sample_points(req.sample_points()).x, tol_);
+  const auto& r = msg::payload_as<fb::SolidSolveReply>(cursor_.reply());
   reply = msg::to_contact(r);
   return msg::to_stats(r.stats());
 }
 
 void ReplaySolid::end_step(bool accept) {
-  const auto& e = cursor_.next(fb::Payload::StepEnd);
-  check_end(cursor_, *cursor_.request(e).payload_as_StepEnd(), accept);
+  check_end(cursor_, *cursor_.next(fb::Payload::StepEnd).payload_as_StepEnd(), accept);
 }
 
 void ReplaySolid::finish() { cursor_.next(fb::Payload::Shutdown); }

@@ -18,6 +18,12 @@ inline void check(int rc, std::string_view context) {
   if (rc < 0) throw_status(rc, context);
 }
 
+// Same with the context "<what> '<key>'", only built on failure: calls made for every message
+// (put, recv) allocate no error text when they succeed.
+inline void check(int rc, std::string_view what, std::string_view key) {
+  if (rc < 0) throw_status(rc, std::string(what) + " '" + std::string(key) + "'");
+}
+
 // Same bound as the shim applies: "forever"-style values (milliseconds::max()) must not
 // overflow deadline arithmetic.
 inline std::chrono::milliseconds clamp_timeout(std::chrono::milliseconds d) {

@@ -8,14 +8,8 @@ namespace angio::transport {
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
-void LivelinessToken::Dropper::operator()(az_token* t) const noexcept { az_liveliness_token_drop(t); }
-
 LivelinessToken::LivelinessToken(az_token* handle, std::string key)
     : handle_(handle), key_(std::move(key)) {}
-
-void LivelinessWatcher::Dropper::operator()(az_liveliness_subscriber* s) const noexcept {
-  az_liveliness_subscriber_drop(s);
-}
 
 LivelinessWatcher::LivelinessWatcher(az_liveliness_subscriber* handle, std::string key)
     : handle_(handle), key_(std::move(key)) {}
@@ -26,7 +20,7 @@ std::optional<LivelinessEvent> LivelinessWatcher::recv(milliseconds timeout) {
   const int rc = az_liveliness_subscriber_recv(handle_.get(), detail::to_ms(timeout), &alive, &key);
   OwnedBuffer k = OwnedBuffer::adopt(key);
   if (rc == AZ_TIMEOUT) return std::nullopt;
-  detail::check(rc, "liveliness watch on '" + key_ + "'");
+  detail::check(rc, "liveliness watch on", key_);
   LivelinessEvent ev{to_string(k.view()), alive != 0};
   if (ev.alive) {
     alive_.insert(ev.key);

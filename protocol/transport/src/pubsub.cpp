@@ -5,15 +5,11 @@
 
 namespace angio::transport {
 
-void Publisher::Dropper::operator()(az_publisher* p) const noexcept { az_publisher_drop(p); }
-
 Publisher::Publisher(az_publisher* handle, std::string key) : handle_(handle), key_(std::move(key)) {}
 
 void Publisher::put(ByteView data) const {
-  detail::check(az_publisher_put(handle_.get(), data.data(), data.size()), "publish on '" + key_ + "'");
+  detail::check(az_publisher_put(handle_.get(), data.data(), data.size()), "publish on", key_);
 }
-
-void Subscriber::Dropper::operator()(az_subscriber* s) const noexcept { az_subscriber_drop(s); }
 
 Subscriber::Subscriber(az_subscriber* handle, std::string key) : handle_(handle), key_(std::move(key)) {}
 
@@ -24,7 +20,7 @@ std::optional<Sample> Subscriber::recv(std::chrono::milliseconds timeout) const 
   OwnedBuffer p = OwnedBuffer::adopt(payload);
   OwnedBuffer k = OwnedBuffer::adopt(key);
   if (rc == AZ_TIMEOUT) return std::nullopt;
-  detail::check(rc, "receive on subscriber '" + key_ + "'");
+  detail::check(rc, "receive on subscriber", key_);
   return Sample{to_string(k.view()), p.to_vector()};
 }
 

@@ -7,8 +7,6 @@
 
 namespace angio::transport {
 
-void IncomingQuery::Dropper::operator()(az_query* q) const noexcept { az_query_drop(q); }
-
 IncomingQuery::IncomingQuery(az_query* handle, OwnedBuffer payload)
     : handle_(handle), payload_(std::move(payload)) {}
 
@@ -17,21 +15,18 @@ std::string_view IncomingQuery::key() const {
   return k ? std::string_view(k) : std::string_view();
 }
 
+// az_query_reply / az_query_reply_err free the handle whatever the outcome, so the key is gone
+// by the time a failure is reported; the shim's message names it.
 void IncomingQuery::reply(ByteView data) {
   if (!handle_) throw TransportError("query was already answered");
-  const std::string context = "reply on '" + std::string(key()) + "'";
-  // az_query_reply frees the handle whatever the outcome.
-  detail::check(az_query_reply(handle_.release(), data.data(), data.size()), context);
+  detail::check(az_query_reply(handle_.release(), data.data(), data.size()), "reply");
 }
 
 void IncomingQuery::reply_error(std::string_view message) {
   if (!handle_) throw TransportError("query was already answered");
-  const std::string context = "error reply on '" + std::string(key()) + "'";
   const ByteView bytes = as_bytes(message);
-  detail::check(az_query_reply_err(handle_.release(), bytes.data(), bytes.size()), context);
+  detail::check(az_query_reply_err(handle_.release(), bytes.data(), bytes.size()), "error reply");
 }
-
-void Queryable::Dropper::operator()(az_queryable* q) const noexcept { az_queryable_drop(q); }
 
 Queryable::Queryable(az_queryable* handle, std::string key) : handle_(handle), key_(std::move(key)) {}
 
@@ -40,7 +35,7 @@ std::optional<IncomingQuery> Queryable::recv(std::chrono::milliseconds timeout) 
   az_bytes payload{nullptr, 0};
   const int rc = az_queryable_recv(handle_.get(), detail::to_ms(timeout), &q, &payload);
   if (rc == AZ_TIMEOUT) return std::nullopt;
-  detail::check(rc, "receive on queryable '" + key_ + "'");
+  detail::check(rc, "receive on queryable", key_);
   return IncomingQuery(q, OwnedBuffer::adopt(payload));
 }
 

@@ -1,5 +1,6 @@
 // Session::request / request_once: the requesting side of request/reply.
 #include <algorithm>
+#include <optional>
 #include <thread>
 
 #include "angio/transport/errors.hpp"
@@ -24,51 +25,41 @@ std::string timeout_message(const std::string& key, milliseconds timeout, bool r
          ")";
 }
 
-// One az_request call; returns the status and fills `reply` on AZ_OK.
-int attempt(az_session* s, const std::string& key, ByteView payload, milliseconds timeout,
-            OwnedBuffer& reply) {
+// One az_request call waiting at most `wait`: the reply, or nullopt when the request finished
+// without any (no queryable reachable). Throws TimeoutError naming the caller's `timeout` when
+// the queryable did not answer in time, RemoteError / TransportError on failures.
+std::optional<Bytes> attempt(az_session* s, const std::string& key, ByteView payload, milliseconds wait,
+                             milliseconds timeout) {
   az_bytes raw{nullptr, 0};
-  const int rc = az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(timeout), &raw);
-  reply = OwnedBuffer::adopt(raw);
-  return rc;
-}
-
-}  // namespace
-
-Bytes Session::request_once(const std::string& key, ByteView payload, milliseconds timeout) const {
-  OwnedBuffer reply;
-  const int rc = attempt(checked(), key, payload, timeout, reply);
+  const int rc = az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(wait), &raw);
+  const OwnedBuffer reply = OwnedBuffer::adopt(raw);
   switch (rc) {
     case AZ_OK:
       return reply.to_vector();
     case AZ_TIMEOUT:
       throw TimeoutError(timeout_message(key, timeout, true));
     case AZ_NO_REPLY:
-      throw NoReplyError("request to '" + key + "' finished without reply (no queryable reachable)");
+      return std::nullopt;
     default:
       detail::throw_status(rc, "request to '" + key + "'");
   }
 }
 
+}  // namespace
+
+Bytes Session::request_once(const std::string& key, ByteView payload, milliseconds timeout) const {
+  if (auto reply = attempt(checked(), key, payload, timeout, timeout)) return std::move(*reply);
+  throw NoReplyError("request to '" + key + "' finished without reply (no queryable reachable)");
+}
+
 Bytes Session::request(const std::string& key, ByteView payload, milliseconds timeout) const {
   const auto deadline = Clock::now() + detail::clamp_timeout(timeout);
-  OwnedBuffer reply;
   for (;;) {
     const auto remaining = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
     if (remaining <= milliseconds::zero()) throw TimeoutError(timeout_message(key, timeout, false));
-    const int rc = attempt(checked(), key, payload, remaining, reply);
-    switch (rc) {
-      case AZ_OK:
-        return reply.to_vector();
-      case AZ_TIMEOUT:
-        throw TimeoutError(timeout_message(key, timeout, true));
-      case AZ_NO_REPLY:
-        // No queryable known yet (peer still connecting or not started): try again.
-        std::this_thread::sleep_for(std::min(no_route_backoff, remaining));
-        break;
-      default:
-        detail::throw_status(rc, "request to '" + key + "'");
-    }
+    if (auto reply = attempt(checked(), key, payload, remaining, timeout)) return std::move(*reply);
+    // No queryable known yet (peer still connecting or not started): try again.
+    std::this_thread::sleep_for(std::min(no_route_backoff, remaining));
   }
 }
 

@@ -26,9 +26,16 @@ std::string describe(const SessionConfig& c) {
   return "listen " + join(c.listen) + ", connect " + join(c.connect);
 }
 
-}  // namespace
+// Shared body of the declare_* functions whose shim call takes (session, key, out).
+template <class Entity, class Raw>
+Entity declare(az_session* s, const std::string& key,
+               int (*shim_declare)(const az_session*, const char*, Raw**), std::string_view what) {
+  Raw* handle = nullptr;
+  detail::check(shim_declare(s, key.c_str(), &handle), what, key);
+  return Entity(handle, key);
+}
 
-void Session::Closer::operator()(az_session* s) const noexcept { az_session_close(s); }
+}  // namespace
 
 Session Session::open(const SessionConfig& config) {
   const auto listen = c_strings(config.listen);
@@ -56,41 +63,32 @@ std::string Session::zid() const {
 }
 
 Queryable Session::declare_queryable(const std::string& key) const {
-  az_queryable* q = nullptr;
-  detail::check(az_queryable_declare(checked(), key.c_str(), &q), "declare_queryable '" + key + "'");
-  return Queryable(q, key);
+  return declare<Queryable>(checked(), key, az_queryable_declare, "declare_queryable");
 }
 
 Publisher Session::declare_publisher(const std::string& key) const {
-  az_publisher* p = nullptr;
-  detail::check(az_publisher_declare(checked(), key.c_str(), &p), "declare_publisher '" + key + "'");
-  return Publisher(p, key);
+  return declare<Publisher>(checked(), key, az_publisher_declare, "declare_publisher");
 }
 
 Subscriber Session::declare_subscriber(const std::string& key) const {
-  az_subscriber* s = nullptr;
-  detail::check(az_subscriber_declare(checked(), key.c_str(), &s), "declare_subscriber '" + key + "'");
-  return Subscriber(s, key);
+  return declare<Subscriber>(checked(), key, az_subscriber_declare, "declare_subscriber");
 }
 
 LivelinessToken Session::declare_liveliness_token(const std::string& key) const {
-  az_token* t = nullptr;
-  detail::check(az_liveliness_token_declare(checked(), key.c_str(), &t),
-                "declare_liveliness_token '" + key + "'");
-  return LivelinessToken(t, key);
+  return declare<LivelinessToken>(checked(), key, az_liveliness_token_declare, "declare_liveliness_token");
 }
 
 LivelinessWatcher Session::watch_liveliness(const std::string& key) const {
   az_liveliness_subscriber* s = nullptr;
   detail::check(az_liveliness_subscriber_declare(checked(), key.c_str(), /*history=*/1, &s),
-                "watch_liveliness '" + key + "'");
+                "watch_liveliness", key);
   return LivelinessWatcher(s, key);
 }
 
 bool Session::liveliness_alive(const std::string& key, std::chrono::milliseconds timeout) const {
   std::size_t count = 0;
   detail::check(az_liveliness_count(checked(), key.c_str(), detail::to_ms(timeout), &count),
-                "liveliness query '" + key + "'");
+                "liveliness query", key);
   return count > 0;
 }
 

@@ -3,8 +3,11 @@
 
 use std::cell::RefCell;
 use std::ffi::{c_char, c_int, CStr, CString};
+use std::fmt::Display;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Duration;
+
+use zenoh::handlers::FifoChannelHandler;
 
 pub const AZ_OK: c_int = 0;
 pub const AZ_TIMEOUT: c_int = 1;
@@ -66,6 +69,29 @@ pub(crate) fn guard(f: impl FnOnce() -> Result<c_int, Fail>) -> c_int {
 /// Like `guard` for functions with no status to report (destructors).
 pub(crate) fn guard_void(f: impl FnOnce()) {
     let _ = catch_unwind(AssertUnwindSafe(f));
+}
+
+/// Shared body of every `az_*_drop`: takes back the box handed to C and passes its content to
+/// `release` (an undeclare, or plain `drop`). NULL is a no-op.
+pub(crate) unsafe fn drop_handle<T>(p: *mut T, release: impl FnOnce(T)) {
+    guard_void(|| {
+        if !p.is_null() {
+            release(*Box::from_raw(p));
+        }
+    })
+}
+
+/// Shared wait of the receive functions (subscriber, liveliness subscriber, queryable):
+/// `Some(item)`, `None` when nothing arrived within `timeout_ms`, or `AZ_ERR_DISCONNECTED`
+/// naming `what` once the channel is closed (session closed).
+pub(crate) fn recv_fifo<T>(
+    handler: &FifoChannelHandler<T>,
+    timeout_ms: u64,
+    what: impl Display,
+) -> Result<Option<T>, Fail> {
+    handler
+        .recv_timeout(ms(timeout_ms))
+        .map_err(|e| Fail(AZ_ERR_DISCONNECTED, format!("{what} channel closed: {e}")))
 }
 
 pub(crate) unsafe fn str_arg<'a>(p: *const c_char, what: &str) -> Result<&'a str, Fail> {
@@ -131,10 +157,11 @@ impl az_bytes {
     }
 }
 
-pub(crate) fn write_bytes(out: *mut az_bytes, v: Vec<u8>) {
+/// Fills an optional output buffer with a copy of `v`; nothing is copied when `out` is NULL.
+pub(crate) fn write_bytes(out: *mut az_bytes, v: &[u8]) {
     // SAFETY: callers check `out` for NULL or pass a pointer validated by `out_ptr`.
     if let Some(o) = unsafe { out.as_mut() } {
-        *o = az_bytes::from_vec(v);
+        *o = az_bytes::from_vec(v.to_vec());
     }
 }
 

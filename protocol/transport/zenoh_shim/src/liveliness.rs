@@ -10,7 +10,7 @@ use zenoh::sample::{Sample, SampleKind};
 use zenoh::Wait;
 
 use crate::ffi::*;
-use crate::session::az_session;
+use crate::session::{az_session, declare_on};
 
 // ---------------------------------------------------------------------------------------------
 // Liveliness
@@ -32,29 +32,16 @@ pub unsafe extern "C" fn az_liveliness_token_declare(
     keyexpr: *const c_char,
     out: *mut *mut az_token,
 ) -> c_int {
-    guard(|| {
-        let out = out_ptr(out, "token")?;
-        *out = std::ptr::null_mut();
-        let s = handle(s, "session")?;
-        let key = str_arg(keyexpr, "keyexpr")?;
-        let token = s
-            .session
-            .liveliness()
-            .declare_token(key.to_string())
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot declare liveliness token '{key}': {e}")))?;
-        *out = Box::into_raw(Box::new(az_token { token }));
-        Ok(AZ_OK)
+    declare_on(s, keyexpr, out, "liveliness token", |session, key| {
+        let token = session.liveliness().declare_token(key.to_string()).wait()?;
+        Ok(az_token { token })
     })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn az_liveliness_token_drop(t: *mut az_token) {
-    guard_void(|| {
-        if !t.is_null() {
-            let t = Box::from_raw(t);
-            let _ = t.token.undeclare().wait();
-        }
+    drop_handle(t, |t| {
+        let _ = t.token.undeclare().wait();
     })
 }
 
@@ -101,20 +88,13 @@ pub unsafe extern "C" fn az_liveliness_subscriber_declare(
     history: c_int,
     out: *mut *mut az_liveliness_subscriber,
 ) -> c_int {
-    guard(|| {
-        let out = out_ptr(out, "liveliness subscriber")?;
-        *out = std::ptr::null_mut();
-        let s = handle(s, "session")?;
-        let key = str_arg(keyexpr, "keyexpr")?;
-        let subscriber = s
-            .session
+    declare_on(s, keyexpr, out, "liveliness subscriber", |session, key| {
+        let subscriber = session
             .liveliness()
             .declare_subscriber(key.to_string())
             .history(history != 0)
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot subscribe to liveliness of '{key}': {e}")))?;
-        *out = Box::into_raw(Box::new(az_liveliness_subscriber { subscriber }));
-        Ok(AZ_OK)
+            .wait()?;
+        Ok(az_liveliness_subscriber { subscriber })
     })
 }
 
@@ -131,29 +111,20 @@ pub unsafe extern "C" fn az_liveliness_subscriber_recv(
     guard(|| {
         let out_alive = out_ptr(out_alive, "alive flag")?;
         *out_alive = 0;
-        write_bytes(out_key, Vec::new());
+        write_bytes(out_key, &[]);
         let sub = handle(sub, "liveliness subscriber")?;
-        match sub.subscriber.handler().recv_timeout(ms(timeout_ms)) {
-            Ok(Some(sample)) => {
-                *out_alive = c_int::from(sample.kind() == SampleKind::Put);
-                write_bytes(out_key, sample.key_expr().as_str().as_bytes().to_vec());
-                Ok(AZ_OK)
-            }
-            Ok(None) => Ok(AZ_TIMEOUT),
-            Err(e) => Err(Fail(
-                AZ_ERR_DISCONNECTED,
-                format!("liveliness channel closed: {e}"),
-            )),
-        }
+        let Some(sample) = recv_fifo(sub.subscriber.handler(), timeout_ms, "liveliness")? else {
+            return Ok(AZ_TIMEOUT);
+        };
+        *out_alive = c_int::from(sample.kind() == SampleKind::Put);
+        write_bytes(out_key, sample.key_expr().as_str().as_bytes());
+        Ok(AZ_OK)
     })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn az_liveliness_subscriber_drop(sub: *mut az_liveliness_subscriber) {
-    guard_void(|| {
-        if !sub.is_null() {
-            let sub = Box::from_raw(sub);
-            let _ = sub.subscriber.undeclare().wait();
-        }
+    drop_handle(sub, |sub| {
+        let _ = sub.subscriber.undeclare().wait();
     })
 }

@@ -8,7 +8,7 @@ use zenoh::sample::Sample;
 use zenoh::Wait;
 
 use crate::ffi::*;
-use crate::session::az_session;
+use crate::session::{az_session, declare_on};
 
 // ---------------------------------------------------------------------------------------------
 // Publish / subscribe
@@ -28,18 +28,9 @@ pub unsafe extern "C" fn az_publisher_declare(
     keyexpr: *const c_char,
     out: *mut *mut az_publisher,
 ) -> c_int {
-    guard(|| {
-        let out = out_ptr(out, "publisher")?;
-        *out = std::ptr::null_mut();
-        let s = handle(s, "session")?;
-        let key = str_arg(keyexpr, "keyexpr")?;
-        let publisher = s
-            .session
-            .declare_publisher(key.to_string())
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot declare publisher on '{key}': {e}")))?;
-        *out = Box::into_raw(Box::new(az_publisher { publisher }));
-        Ok(AZ_OK)
+    declare_on(s, keyexpr, out, "publisher", |session, key| {
+        let publisher = session.declare_publisher(key.to_string()).wait()?;
+        Ok(az_publisher { publisher })
     })
 }
 
@@ -64,11 +55,8 @@ pub unsafe extern "C" fn az_publisher_put(
 
 #[no_mangle]
 pub unsafe extern "C" fn az_publisher_drop(p: *mut az_publisher) {
-    guard_void(|| {
-        if !p.is_null() {
-            let p = Box::from_raw(p);
-            let _ = p.publisher.undeclare().wait();
-        }
+    drop_handle(p, |p| {
+        let _ = p.publisher.undeclare().wait();
     })
 }
 
@@ -78,18 +66,9 @@ pub unsafe extern "C" fn az_subscriber_declare(
     keyexpr: *const c_char,
     out: *mut *mut az_subscriber,
 ) -> c_int {
-    guard(|| {
-        let out = out_ptr(out, "subscriber")?;
-        *out = std::ptr::null_mut();
-        let s = handle(s, "session")?;
-        let key = str_arg(keyexpr, "keyexpr")?;
-        let subscriber = s
-            .session
-            .declare_subscriber(key.to_string())
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot declare subscriber on '{key}': {e}")))?;
-        *out = Box::into_raw(Box::new(az_subscriber { subscriber }));
-        Ok(AZ_OK)
+    declare_on(s, keyexpr, out, "subscriber", |session, key| {
+        let subscriber = session.declare_subscriber(key.to_string()).wait()?;
+        Ok(az_subscriber { subscriber })
     })
 }
 
@@ -105,29 +84,20 @@ pub unsafe extern "C" fn az_subscriber_recv(
     guard(|| {
         let out_payload = out_ptr(out_payload, "payload")?;
         *out_payload = az_bytes::empty();
-        write_bytes(out_key, Vec::new());
+        write_bytes(out_key, &[]);
         let sub = handle(sub, "subscriber")?;
-        match sub.subscriber.handler().recv_timeout(ms(timeout_ms)) {
-            Ok(Some(sample)) => {
-                *out_payload = az_bytes::from_vec(zbytes_to_vec(sample.payload()));
-                write_bytes(out_key, sample.key_expr().as_str().as_bytes().to_vec());
-                Ok(AZ_OK)
-            }
-            Ok(None) => Ok(AZ_TIMEOUT),
-            Err(e) => Err(Fail(
-                AZ_ERR_DISCONNECTED,
-                format!("subscriber channel closed: {e}"),
-            )),
-        }
+        let Some(sample) = recv_fifo(sub.subscriber.handler(), timeout_ms, "subscriber")? else {
+            return Ok(AZ_TIMEOUT);
+        };
+        *out_payload = az_bytes::from_vec(zbytes_to_vec(sample.payload()));
+        write_bytes(out_key, sample.key_expr().as_str().as_bytes());
+        Ok(AZ_OK)
     })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn az_subscriber_drop(sub: *mut az_subscriber) {
-    guard_void(|| {
-        if !sub.is_null() {
-            let sub = Box::from_raw(sub);
-            let _ = sub.subscriber.undeclare().wait();
-        }
+    drop_handle(sub, |sub| {
+        let _ = sub.subscriber.undeclare().wait();
     })
 }

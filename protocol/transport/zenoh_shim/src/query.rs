@@ -8,7 +8,7 @@ use zenoh::query::{ConsolidationMode, Query, Queryable, Reply};
 use zenoh::Wait;
 
 use crate::ffi::*;
-use crate::session::az_session;
+use crate::session::{az_session, declare_on};
 
 // ---------------------------------------------------------------------------------------------
 // Queryable / incoming queries
@@ -30,29 +30,17 @@ pub unsafe extern "C" fn az_queryable_declare(
     keyexpr: *const c_char,
     out: *mut *mut az_queryable,
 ) -> c_int {
-    guard(|| {
-        let out = out_ptr(out, "queryable")?;
-        *out = std::ptr::null_mut();
-        let s = handle(s, "session")?;
-        let key = str_arg(keyexpr, "keyexpr")?;
-        let queryable = s
-            .session
-            .declare_queryable(key.to_string())
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot declare queryable on '{key}': {e}")))?;
-        *out = Box::into_raw(Box::new(az_queryable { queryable }));
-        Ok(AZ_OK)
+    declare_on(s, keyexpr, out, "queryable", |session, key| {
+        let queryable = session.declare_queryable(key.to_string()).wait()?;
+        Ok(az_queryable { queryable })
     })
 }
 
 /// Undeclares the queryable and frees it. Queries already received stay valid. NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn az_queryable_drop(q: *mut az_queryable) {
-    guard_void(|| {
-        if !q.is_null() {
-            let q = Box::from_raw(q);
-            let _ = q.queryable.undeclare().wait();
-        }
+    drop_handle(q, |q| {
+        let _ = q.queryable.undeclare().wait();
     })
 }
 
@@ -72,20 +60,20 @@ pub unsafe extern "C" fn az_queryable_recv(
         let out_payload = out_ptr(out_payload, "payload")?;
         *out_payload = az_bytes::empty();
         let q = handle(q, "queryable")?;
-        match q.queryable.handler().recv_timeout(ms(timeout_ms)) {
-            Ok(Some(query)) => {
-                let payload = query.payload().map(zbytes_to_vec).unwrap_or_default();
-                let key = CString::new(query.key_expr().as_str()).unwrap_or_default();
-                *out_payload = az_bytes::from_vec(payload);
-                *out_query = Box::into_raw(Box::new(az_query { query, key }));
-                Ok(AZ_OK)
-            }
-            Ok(None) => Ok(AZ_TIMEOUT),
-            Err(e) => Err(Fail(
-                AZ_ERR_DISCONNECTED,
-                format!("queryable '{}' channel closed: {e}", q.queryable.key_expr()),
-            )),
-        }
+        let key = q.queryable.key_expr();
+        let received = recv_fifo(
+            q.queryable.handler(),
+            timeout_ms,
+            format_args!("queryable '{key}'"),
+        )?;
+        let Some(query) = received else {
+            return Ok(AZ_TIMEOUT);
+        };
+        let payload = query.payload().map(zbytes_to_vec).unwrap_or_default();
+        let key = CString::new(query.key_expr().as_str()).unwrap_or_default();
+        *out_payload = az_bytes::from_vec(payload);
+        *out_query = Box::into_raw(Box::new(az_query { query, key }));
+        Ok(AZ_OK)
     })
 }
 
@@ -98,21 +86,36 @@ pub unsafe extern "C" fn az_query_keyexpr(q: *const az_query) -> *const c_char {
     }
 }
 
-/// Sends `data` as the reply and frees the query handle (always, even on error).
-#[no_mangle]
-pub unsafe extern "C" fn az_query_reply(q: *mut az_query, data: *const u8, len: usize) -> c_int {
+/// Shared body of the two replies: frees the query handle whatever the outcome, and sends
+/// `data` with `send`; a failure names `what` and the query's key.
+unsafe fn answer(
+    q: *mut az_query,
+    data: *const u8,
+    len: usize,
+    what: &str,
+    send: impl FnOnce(&Query, Vec<u8>) -> zenoh::Result<()>,
+) -> c_int {
     guard(|| {
         if q.is_null() {
             return Err(Fail::arg("query handle is NULL"));
         }
         let q = Box::from_raw(q);
         let bytes = bytes_arg(data, len)?.to_vec();
-        let key = q.query.key_expr().clone();
-        q.query
-            .reply(key.clone(), bytes)
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot reply to query on '{key}': {e}")))?;
+        send(&q.query, bytes).map_err(|e| {
+            Fail::err(format!(
+                "cannot send {what} to query on '{}': {e}",
+                q.query.key_expr()
+            ))
+        })?;
         Ok(AZ_OK)
+    })
+}
+
+/// Sends `data` as the reply and frees the query handle (always, even on error).
+#[no_mangle]
+pub unsafe extern "C" fn az_query_reply(q: *mut az_query, data: *const u8, len: usize) -> c_int {
+    answer(q, data, len, "reply", |query, bytes| {
+        query.reply(query.key_expr().clone(), bytes).wait()
     })
 }
 
@@ -124,29 +127,15 @@ pub unsafe extern "C" fn az_query_reply_err(
     data: *const u8,
     len: usize,
 ) -> c_int {
-    guard(|| {
-        if q.is_null() {
-            return Err(Fail::arg("query handle is NULL"));
-        }
-        let q = Box::from_raw(q);
-        let bytes = bytes_arg(data, len)?.to_vec();
-        let key = q.query.key_expr().clone();
-        q.query
-            .reply_err(bytes)
-            .wait()
-            .map_err(|e| Fail::err(format!("cannot send error reply to query on '{key}': {e}")))?;
-        Ok(AZ_OK)
+    answer(q, data, len, "error reply", |query, bytes| {
+        query.reply_err(bytes).wait()
     })
 }
 
 /// Frees a query without replying; the requester then gets AZ_NO_REPLY. NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn az_query_drop(q: *mut az_query) {
-    guard_void(|| {
-        if !q.is_null() {
-            drop(Box::from_raw(q));
-        }
-    })
+    drop_handle(q, drop)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -199,7 +188,7 @@ fn reply_to_status(reply: Reply, key: &str, out: &mut az_bytes) -> Result<c_int,
             Ok(AZ_OK)
         }
         Err(err) => {
-            let msg = String::from_utf8_lossy(&zbytes_to_vec(err.payload())).into_owned();
+            let msg = String::from_utf8_lossy(&err.payload().to_bytes()).into_owned();
             Err(Fail(
                 AZ_ERR_REPLY,
                 format!("error reply from '{key}': {msg}"),

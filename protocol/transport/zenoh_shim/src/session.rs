@@ -14,6 +14,28 @@ pub struct az_session {
     pub(crate) session: Session,
 }
 
+/// Shared body of every `az_*_declare` on a session: checks the arguments, runs `declare` with
+/// the session and the key expression, and hands the boxed result to C in `*out` (NULL on any
+/// failure, whose message names `what` and the key).
+pub(crate) unsafe fn declare_on<T>(
+    s: *const az_session,
+    keyexpr: *const c_char,
+    out: *mut *mut T,
+    what: &str,
+    declare: impl FnOnce(&Session, &str) -> zenoh::Result<T>,
+) -> c_int {
+    guard(|| {
+        let out = out_ptr(out, what)?;
+        *out = std::ptr::null_mut();
+        let s = handle(s, "session")?;
+        let key = str_arg(keyexpr, "keyexpr")?;
+        let entity = declare(&s.session, key)
+            .map_err(|e| Fail::err(format!("cannot declare {what} on '{key}': {e}")))?;
+        *out = Box::into_raw(Box::new(entity));
+        Ok(AZ_OK)
+    })
+}
+
 fn json_string(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 2);
     out.push('"');

@@ -27,12 +27,12 @@ fb::Role role_from_name(const std::string& name);
 class Cursor {
  public:
   Cursor(const recording::Recording& rec, fb::Role role);
-  // The next exchange, which must carry a request of payload type `expected`.
-  const recording::Exchange& next(fb::Payload expected);
-  const fb::Envelope& request(const recording::Exchange& e) const;
-  const fb::Envelope& reply(const recording::Exchange& e) const;
+  // Moves to the next exchange, which must carry a request of payload type `expected`, and
+  // returns that (verified) request.
+  const fb::Envelope& next(fb::Payload expected);
+  // The recorded reply of the exchange `next` moved to.
+  const fb::Envelope& reply() const;
   std::size_t position() const { return pos_; }
-  std::size_t remaining() const { return items_.size() - pos_; }
 
  private:
   std::vector<const recording::Exchange*> items_;

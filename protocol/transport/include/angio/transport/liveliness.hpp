@@ -2,29 +2,22 @@
 // Peer presence: a process holds a LivelinessToken for as long as it is up; the other side
 // watches the token's key and learns when it disappears (clean exit, crash or kill alike).
 #include <chrono>
-#include <memory>
 #include <optional>
 #include <set>
 #include <string>
 
-struct az_token;
-struct az_liveliness_subscriber;
+#include "angio/transport/handle.hpp"
 
 namespace angio::transport {
 
 class LivelinessToken {
  public:
   LivelinessToken(az_token* handle, std::string key);
-  LivelinessToken(LivelinessToken&&) noexcept = default;
-  LivelinessToken& operator=(LivelinessToken&&) noexcept = default;
 
   const std::string& key() const { return key_; }
 
  private:
-  struct Dropper {
-    void operator()(az_token* t) const noexcept;
-  };
-  std::unique_ptr<az_token, Dropper> handle_;
+  detail::ShimHandle<az_token> handle_;
   std::string key_;
 };
 
@@ -37,8 +30,6 @@ struct LivelinessEvent {
 class LivelinessWatcher {
  public:
   LivelinessWatcher(az_liveliness_subscriber* handle, std::string key);
-  LivelinessWatcher(LivelinessWatcher&&) noexcept = default;
-  LivelinessWatcher& operator=(LivelinessWatcher&&) noexcept = default;
 
   const std::string& key() const { return key_; }
 
@@ -54,10 +45,7 @@ class LivelinessWatcher {
   const std::set<std::string>& alive_keys() const { return alive_; }
 
  private:
-  struct Dropper {
-    void operator()(az_liveliness_subscriber* s) const noexcept;
-  };
-  std::unique_ptr<az_liveliness_subscriber, Dropper> handle_;
+  detail::ShimHandle<az_liveliness_subscriber> handle_;
   std::string key_;
   std::set<std::string> alive_;
 };

@@ -4,16 +4,13 @@
 #include <chrono>
 #include <cstddef>
 #include <functional>
-#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 
 #include "angio/transport/bytes.hpp"
+#include "angio/transport/handle.hpp"
 #include "angio/transport/owned_buffer.hpp"
-
-struct az_queryable;
-struct az_query;
 
 namespace angio::transport {
 
@@ -23,9 +20,6 @@ namespace angio::transport {
 class IncomingQuery {
  public:
   IncomingQuery(az_query* handle, OwnedBuffer payload);
-  IncomingQuery(IncomingQuery&&) noexcept = default;
-  IncomingQuery& operator=(IncomingQuery&&) noexcept = default;
-  ~IncomingQuery() = default;
 
   std::string_view key() const;  // empty once answered
   ByteView payload() const { return payload_.view(); }
@@ -35,10 +29,7 @@ class IncomingQuery {
   void reply_error(std::string_view message);
 
  private:
-  struct Dropper {
-    void operator()(az_query* q) const noexcept;
-  };
-  std::unique_ptr<az_query, Dropper> handle_;
+  detail::ShimHandle<az_query> handle_;
   OwnedBuffer payload_;
 };
 
@@ -48,8 +39,6 @@ class Queryable {
   using Handler = std::function<Bytes(const IncomingQuery&)>;
 
   Queryable(az_queryable* handle, std::string key);
-  Queryable(Queryable&&) noexcept = default;
-  Queryable& operator=(Queryable&&) noexcept = default;
 
   const std::string& key() const { return key_; }
 
@@ -63,10 +52,7 @@ class Queryable {
                     std::chrono::milliseconds poll = std::chrono::milliseconds(100)) const;
 
  private:
-  struct Dropper {
-    void operator()(az_queryable* q) const noexcept;
-  };
-  std::unique_ptr<az_queryable, Dropper> handle_;
+  detail::ShimHandle<az_queryable> handle_;
   std::string key_;
 };
 

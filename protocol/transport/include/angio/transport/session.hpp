@@ -1,28 +1,23 @@
 #pragma once
 // A zenoh peer session: the entry point that opens the connection and declares everything else.
 #include <chrono>
-#include <memory>
 #include <string>
 
 #include "angio/transport/bytes.hpp"
 #include "angio/transport/config.hpp"
+#include "angio/transport/handle.hpp"
 #include "angio/transport/liveliness.hpp"
 #include "angio/transport/publisher.hpp"
 #include "angio/transport/queryable.hpp"
 #include "angio/transport/subscriber.hpp"
 
-struct az_session;
-
 namespace angio::transport {
 
+// Move-only. Destruction closes the session, ignoring errors; close() reports them.
 class Session {
  public:
   // Throws TransportError if a listen endpoint cannot be bound or the config is invalid.
   static Session open(const SessionConfig& config);
-
-  Session(Session&&) noexcept = default;
-  Session& operator=(Session&&) noexcept = default;
-  ~Session() = default;  // closes the session (errors ignored); use close() to see them
 
   void close();
   bool is_open() const { return static_cast<bool>(handle_); }
@@ -51,12 +46,9 @@ class Session {
   az_session* raw() const noexcept { return handle_.get(); }
 
  private:
-  struct Closer {
-    void operator()(az_session* s) const noexcept;
-  };
   explicit Session(az_session* s) : handle_(s) {}
   az_session* checked() const;
-  std::unique_ptr<az_session, Closer> handle_;
+  detail::ShimHandle<az_session> handle_;
 };
 
 }  // namespace angio::transport

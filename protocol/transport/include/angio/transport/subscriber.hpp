@@ -1,13 +1,11 @@
 #pragma once
 // Receives publications on a key expression (wildcards allowed), queued until recv.
 #include <chrono>
-#include <memory>
 #include <optional>
 #include <string>
 
 #include "angio/transport/bytes.hpp"
-
-struct az_subscriber;
+#include "angio/transport/handle.hpp"
 
 namespace angio::transport {
 
@@ -20,18 +18,13 @@ struct Sample {
 class Subscriber {
  public:
   Subscriber(az_subscriber* handle, std::string key);
-  Subscriber(Subscriber&&) noexcept = default;
-  Subscriber& operator=(Subscriber&&) noexcept = default;
 
   const std::string& key() const { return key_; }
   // Next sample, or nullopt if none arrived within `timeout`.
   std::optional<Sample> recv(std::chrono::milliseconds timeout) const;
 
  private:
-  struct Dropper {
-    void operator()(az_subscriber* s) const noexcept;
-  };
-  std::unique_ptr<az_subscriber, Dropper> handle_;
+  detail::ShimHandle<az_subscriber> handle_;
   std::string key_;
 };
 
