@@ -13,15 +13,8 @@ int num_nodes(ElemType t) {
   }
   return 0;
 }
-int num_nodes(FaceType t) {
-  switch (t) {
-    case FaceType::Quad4: return 4;
-    case FaceType::Tri3: return 3;
-    case FaceType::Tri6: return 6;
-  }
-  return 0;
-}
-int num_corners(FaceType t) { return t == FaceType::Quad4 ? 4 : 3; }
+int num_nodes(FaceType t) { return contact::num_nodes(to_contact(t)); }
+int num_corners(FaceType t) { return contact::num_corners(to_contact(t)); }
 const char* name(ElemType t) {
   switch (t) {
     case ElemType::Hex8: return "hex8";
@@ -30,14 +23,7 @@ const char* name(ElemType t) {
   }
   return "?";
 }
-const char* name(FaceType t) {
-  switch (t) {
-    case FaceType::Quad4: return "quad4";
-    case FaceType::Tri3: return "tri3";
-    case FaceType::Tri6: return "tri6";
-  }
-  return "?";
-}
+const char* name(FaceType t) { return contact::name(to_contact(t)); }
 
 const std::vector<QuadPoint>& volume_rule(ElemType t) {
   static const std::vector<QuadPoint> hex = [] {
@@ -127,38 +113,11 @@ void shape(ElemType t, const double* xi, Eigen::VectorXd& N, Eigen::MatrixXd& dN
 }
 
 void shape(FaceType t, const double* xi, Eigen::VectorXd& N, Eigen::MatrixXd& dN) {
-  const int n = num_nodes(t);
-  N.resize(n);
-  dN.resize(n, 2);
-  if (t == FaceType::Quad4) {
-    static const int s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-    for (int a = 0; a < 4; ++a) {
-      N(a) = 0.25 * (1 + s[a][0] * xi[0]) * (1 + s[a][1] * xi[1]);
-      dN(a, 0) = 0.25 * s[a][0] * (1 + s[a][1] * xi[1]);
-      dN(a, 1) = 0.25 * (1 + s[a][0] * xi[0]) * s[a][1];
-    }
-    return;
-  }
-  const double L[3] = {1 - xi[0] - xi[1], xi[0], xi[1]};
-  static const double dL[3][2] = {{-1, -1}, {1, 0}, {0, 1}};
-  if (t == FaceType::Tri3) {
-    for (int a = 0; a < 3; ++a) {
-      N(a) = L[a];
-      dN(a, 0) = dL[a][0];
-      dN(a, 1) = dL[a][1];
-    }
-    return;
-  }
-  static const int e[3][2] = {{0, 1}, {1, 2}, {2, 0}};
-  for (int a = 0; a < 3; ++a) {
-    N(a) = L[a] * (2 * L[a] - 1);
-    for (int j = 0; j < 2; ++j) dN(a, j) = (4 * L[a] - 1) * dL[a][j];
-  }
-  for (int m = 0; m < 3; ++m) {
-    const int p = e[m][0], q = e[m][1];
-    N(3 + m) = 4 * L[p] * L[q];
-    for (int j = 0; j < 2; ++j) dN(3 + m, j) = 4 * (dL[p][j] * L[q] + L[p] * dL[q][j]);
-  }
+  contact::ShapeN n;
+  contact::ShapeD d;
+  contact::shape(to_contact(t), contact::Vec2(xi[0], xi[1]), n, &d);
+  N = n;
+  dN = d;
 }
 
 std::vector<Vec3d> reference_nodes(ElemType t) {

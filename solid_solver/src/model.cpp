@@ -11,14 +11,9 @@
 #include <stdexcept>
 #include <unordered_map>
 
-namespace angio::solid {
+#include "petsc_check.hpp"
 
-#define ANGIO_PETSC(call)                                                                     \
-  do {                                                                                      \
-    PetscErrorCode ierr_ = (call);                                                          \
-    if (ierr_) throw std::runtime_error(std::string("PETSc error in ") + #call + " (code " + \
-                                        std::to_string(int(ierr_)) + ")");                  \
-  } while (0)
+namespace angio::solid {
 
 const char* petsc_default_options() {
   return "-ksp_type gmres -ksp_gmres_restart 200 -ksp_rtol 1e-6 -ksp_atol 1e-14 -ksp_max_it 1000 "
@@ -221,24 +216,23 @@ void SolidModel::setup_petsc_() {
   ANGIO_PETSC(KSPSetFromOptions(ksp_));
 }
 
-void SolidModel::add_pressure(PressureLoad load) {
-  const SurfaceSet* s = mesh_.surface(load.surface);
-  if (!s) throw std::runtime_error("pressure: unknown surface set '" + load.surface + "'");
-  LocalFaces lf;
+std::vector<Face> SolidModel::owned_faces_(const std::string& name, const char* what) const {
+  const SurfaceSet* s = mesh_.surface(name);
+  if (!s) throw std::runtime_error(std::string(what) + ": unknown surface set '" + name + "'");
+  std::vector<Face> faces;
   for (const auto& f : s->faces)
-    if (node_owner_[f.n[0]] == rank_) lf.faces.push_back(f);
+    if (node_owner_[f.n[0]] == rank_) faces.push_back(f);
+  return faces;
+}
+
+void SolidModel::add_pressure(PressureLoad load) {
+  pressure_faces_.push_back(owned_faces_(load.surface, "pressure"));
   pressures_.push_back(std::move(load));
-  pressure_faces_.push_back(std::move(lf));
 }
 
 void SolidModel::add_springs(SpringSupport springs) {
-  const SurfaceSet* s = mesh_.surface(springs.surface);
-  if (!s) throw std::runtime_error("springs: unknown surface set '" + springs.surface + "'");
-  LocalFaces lf;
-  for (const auto& f : s->faces)
-    if (node_owner_[f.n[0]] == rank_) lf.faces.push_back(f);
+  spring_faces_.push_back(owned_faces_(springs.surface, "springs"));
   springs_.push_back(std::move(springs));
-  spring_faces_.push_back(std::move(lf));
 }
 
 void SolidModel::add_dirichlet(DirichletBC bc) {
@@ -317,14 +311,14 @@ bool SolidModel::assemble(Vec r, Mat K) {
   for (size_t i = 0; i < pressures_.size() && ok; ++i) {
     const double p = pressures_[i].pressure(time_);
     if (p == 0.0) continue;
-    for (const auto& f : pressure_faces_[i].faces) {
+    for (const auto& f : pressure_faces_[i]) {
       gather_nodes(f.n.data(), f.nn(), true);
       face_pressure(f.type, X, p, fe, K ? &Ke : nullptr);
       add(f.nn());
     }
   }
   for (size_t i = 0; i < springs_.size() && ok; ++i) {
-    for (const auto& f : spring_faces_[i].faces) {
+    for (const auto& f : spring_faces_[i]) {
       gather_nodes(f.n.data(), f.nn(), false);
       face_springs(f.type, X, u, springs_[i].stiffness, fe, K ? &Ke : nullptr);
       add(f.nn());
@@ -462,12 +456,12 @@ SolveReport SolidModel::solve() {
     if (!finite) return fail("linear solve produced NaN/Inf at Newton iteration " + std::to_string(it));
     u_base = u_;
     // line search (backtracking on ||r||); the tangent is assembled with the trial residual so
-    // that an accepted full step costs no extra assembly.
-    double alpha = 1.0, best_alpha = -1.0, best_res = std::numeric_limits<double>::infinity();
+    // that an accepted full step costs no extra assembly. alpha ends as the last trial's step.
+    double alpha = 1.0, best_alpha = 1.0, best_res = std::numeric_limits<double>::infinity();
     double new_res = 0.0;
     bool accepted = false;
     const int tries = no.line_search ? no.max_line_search + 1 : 1;
-    for (int ls = 0; ls < tries; ++ls) {
+    for (int ls = 0;; ++ls, alpha *= 0.5) {
       for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
       t0 = MPI_Wtime();
       const bool aok = assemble(r_, K_);
@@ -478,18 +472,16 @@ SolveReport SolidModel::solve() {
         best_res = new_res;
         best_alpha = alpha;
       }
-      if (new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res))) {
-        accepted = true;
-        break;
-      }
-      alpha *= 0.5;
+      accepted = new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res));
+      if (accepted || ls + 1 >= tries) break;
     }
     if (!accepted) {
       if (!std::isfinite(best_res))
         return fail("Newton iteration " + std::to_string(it) +
                     ": every line-search trial gave an invalid configuration (inverted element or NaN)");
-      if (best_alpha != 2.0 * alpha) {  // the last trial (2 alpha after the final halving) is not the best
-        for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + best_alpha * du_full[i];
+      if (best_alpha != alpha) {  // r_, K_ hold the last trial: back to the best one
+        alpha = best_alpha;
+        for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
         t0 = MPI_Wtime();
         assemble(r_, K_);
         rep.assembly_seconds += MPI_Wtime() - t0;
@@ -500,7 +492,7 @@ SolveReport SolidModel::solve() {
     rep.residual_history.push_back(res);
     if (no.verbose && rank_ == 0)
       std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d\n", it + 1, res,
-                  accepted ? alpha : best_alpha, int(lits));
+                  alpha, int(lits));
   }
   rep.total_seconds = MPI_Wtime() - t_start;
   return rep;

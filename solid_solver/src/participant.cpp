@@ -58,8 +58,6 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
   }
   record_and_write_(0, time_);
   if (rank_ == 0) {
-    int nloc_e = int(model_->local_elements().size());
-    (void)nloc_e;
     LOG_INFO("solid: " << model_->mesh().elements.size() << " elements, " << model_->num_dofs() << " DOFs on "
                        << size << " rank(s); blocks:" << [&] {
                             std::string s;
@@ -70,6 +68,16 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
 }
 
 SolidRunner::~SolidRunner() = default;
+
+void reset_reply(const participant::SamplePoints& pts, participant::ContactReply& reply) {
+  const size_t n = pts.x.size();
+  reply = participant::ContactReply{};
+  reply.line_loads.assign(n, {0.0, 0.0, 0.0});
+  reply.surface_points = pts.x;
+  reply.normals.assign(n, {0.0, 0.0, 0.0});
+  reply.penalty.assign(n, 0.0);
+  reply.active.assign(n, 0);
+}
 
 void SolidRunner::balloon_diameters(double& mid, double& end0, double& end1) const {
   mid = end0 = end1 = 0.0;
@@ -94,17 +102,11 @@ void SolidRunner::begin_step(int step, double time) {
 participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply) {
   if (stent_contact_) stent_contact_->set_points(pts);
   if (!pts.x.empty() && !stent_contact_ && !warned_contact_ && rank_ == 0) {
-    LOG_WARN("solid: stent contact is not implemented yet; " << pts.x.size()
-                                                              << " beam sample points are ignored (zero line loads)");
+    LOG_WARN("solid: no stent contact configured; " << pts.x.size()
+                                                     << " beam sample points are ignored (zero line loads)");
     warned_contact_ = true;
   }
-  const size_t n = pts.x.size();
-  reply = participant::ContactReply{};
-  reply.line_loads.assign(n, {0.0, 0.0, 0.0});
-  reply.surface_points = pts.x;
-  reply.normals.assign(n, {0.0, 0.0, 0.0});
-  reply.penalty.assign(n, 0.0);
-  reply.active.assign(n, 0);
+  reset_reply(pts, reply);
   last_ = model_->solve();
   if (stent_contact_ && last_.converged) stent_contact_->fill_reply(*model_, reply);
   participant::SolveStats s;

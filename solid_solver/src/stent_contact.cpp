@@ -9,17 +9,11 @@
 #include <stdexcept>
 
 #include "angio/solid/model.hpp"
+#include "petsc_check.hpp"
 
 namespace angio::solid {
 
 namespace {
-
-#define ANGIO_CPETSC(call)                                                                    \
-  do {                                                                                        \
-    PetscErrorCode ierr_ = (call);                                                            \
-    if (ierr_) throw std::runtime_error(std::string("PETSc error in ") + #call + " (code " +   \
-                                        std::to_string(int(ierr_)) + ")");                    \
-  } while (0)
 
 void gather_coords(const SolidModel& model, std::vector<contact::Vec3>& coords) {
   const int n = int(model.mesh().X.size());
@@ -35,15 +29,10 @@ void insert(const SolidModel& model, const std::vector<contact::NodalContributio
     idx.resize(m);
     for (size_t a = 0; a < c.nodes.size(); ++a)
       for (int k = 0; k < 3; ++k) idx[3 * a + k] = model.dof(c.nodes[a], k);
-    ANGIO_CPETSC(VecSetValues(r, m, idx.data(), c.r.data(), ADD_VALUES));
+    ANGIO_PETSC(VecSetValues(r, m, idx.data(), c.r.data(), ADD_VALUES));
     // K is symmetric: the same values in row- or column-major order (the model's Mat is column-oriented).
-    if (K && c.K.rows() == m && c.K.cols() == m) ANGIO_CPETSC(MatSetValues(K, m, idx.data(), m, idx.data(), c.K.data(), ADD_VALUES));
+    if (K && c.K.rows() == m && c.K.cols() == m) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), c.K.data(), ADD_VALUES));
   }
-}
-
-// Contact adds couplings between different bodies that the element preallocation does not have.
-void allow_new_nonzeros(Mat K) {
-  if (K) ANGIO_CPETSC(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
 }
 
 // Global diagnostics from the per-rank slices (sums, min gap), same on every rank.
@@ -79,36 +68,15 @@ contact::Surface to_contact_surface(const SurfaceSet& s, double normal_sign) {
   c.faces.reserve(s.faces.size());
   for (const Face& f : s.faces) {
     contact::Face g;
-    switch (f.type) {
-      case FaceType::Quad4: g.kind = contact::FaceKind::Quad4; break;
-      case FaceType::Tri3: g.kind = contact::FaceKind::Tri3; break;
-      case FaceType::Tri6: g.kind = contact::FaceKind::Tri6; break;
-
-    }
-    if (g.nn() != f.nn()) throw std::runtime_error("contact: face node count mismatch on '" + s.name + "'");
+    g.kind = to_contact(f.type);
     std::copy(f.n.begin(), f.n.begin() + f.nn(), g.nodes.begin());
     c.faces.push_back(g);
   }
   return c;
 }
 
-void reset_reply(const participant::SamplePoints& pts, participant::ContactReply& reply) {
-  const size_t n = pts.x.size();
-  reply = participant::ContactReply{};
-  reply.line_loads.assign(n, {0.0, 0.0, 0.0});
-  reply.surface_points = pts.x;
-  reply.normals.assign(n, {0.0, 0.0, 0.0});
-  reply.penalty.assign(n, 0.0);
-  reply.active.assign(n, 0);
-}
-
 // ------------------------------------------------------------------------------------------------
 // Stent line-to-surface contact
-
-struct PenaltyStentContact::Eval {
-  std::vector<contact::LineContactResult> per_surface;  // one evaluation per surface (own penalty)
-  contact::ContactDiagnostics diag;
-};
 
 PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) : opt_(std::move(opt)) {
   if (!(opt_.search_radius > 0)) throw std::runtime_error("stent contact: search radius must be positive");
@@ -136,10 +104,11 @@ void PenaltyStentContact::set_points(const participant::SamplePoints& pts) {
     points_[i] = contact::BeamPoint{contact::Vec3(pts.x[i][0], pts.x[i][1], pts.x[i][2]), pts.w[i], pts.radius[i]};
 }
 
-void PenaltyStentContact::evaluate_(const SolidModel& model, bool tangent, Eval& out) {
-  out.per_surface.clear();
-  out.diag = {};
-  if (points_.empty() || searches_.empty()) return;
+std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const SolidModel& model,
+                                                                       std::span<const contact::BeamPoint> points,
+                                                                       bool tangent) {
+  std::vector<contact::LineContactResult> per_surface;
+  if (points.empty() || searches_.empty()) return per_surface;
   gather_coords(model, coords_);
   for (size_t k = 0; k < searches_.size(); ++k) {
     searches_[k]->update(coords_, /*rebuild=*/true);
@@ -148,36 +117,21 @@ void PenaltyStentContact::evaluate_(const SolidModel& model, bool tangent, Eval&
     par.penalty = penalty_[k];
     par.regularization = opt_.regularization;
     par.compute_tangent = tangent;
-    out.per_surface.push_back(contact::evaluate_line_contact(points_, one, par));
-    out.diag.merge(out.per_surface.back().diag);
+    per_surface.push_back(contact::evaluate_line_contact(points, one, par));
   }
+  return per_surface;
 }
 
 void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   const double t0 = MPI_Wtime();
-  allow_new_nonzeros(K);
   // every rank holds all coordinates: each evaluates a contiguous slice of the points against the whole
   // surfaces and adds its own contributions (each enters the global system exactly once)
+  std::size_t lo, hi;
+  slice(points_.size(), model.rank(), model.size(), lo, hi);
   contact::ContactDiagnostics diag;
-  if (!points_.empty() && !searches_.empty()) {
-    std::size_t lo, hi;
-    slice(points_.size(), model.rank(), model.size(), lo, hi);
-    if (hi > lo) {
-      gather_coords(model, coords_);
-      const std::span<const contact::BeamPoint> mine(points_.data() + lo, hi - lo);
-      for (size_t k = 0; k < searches_.size(); ++k) {
-        searches_[k]->update(coords_, /*rebuild=*/true);
-        const contact::SurfaceSearch* one[] = {searches_[k].get()};
-        contact::LineContactParams par;
-        par.penalty = penalty_[k];
-        par.regularization = opt_.regularization;
-    par.regularization = opt_.regularization;
-        par.compute_tangent = K != nullptr;
-        const auto res = contact::evaluate_line_contact(mine, one, par);
-        insert(model, res.solid, r, K);
-        diag.merge(res.diag);
-      }
-    }
+  for (const auto& res : evaluate_(model, std::span(points_).subspan(lo, hi - lo), K != nullptr)) {
+    insert(model, res.solid, r, K);
+    diag.merge(res.diag);
   }
   last_ = reduce_summary(diag, 0.0, opt_.search_radius, model.comm(), nullptr);
   timing_.calls++;
@@ -186,29 +140,20 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
 
 void PenaltyStentContact::fill_reply(const SolidModel& model, participant::ContactReply& reply) {
   const size_t n = points_.size();
-  if (reply.line_loads.size() != n) {
-    participant::SamplePoints p;
-    for (const auto& b : points_) {
-      p.x.push_back({b.x(0), b.x(1), b.x(2)});
-      p.w.push_back(b.w);
-      p.radius.push_back(b.R);
-    }
-    reset_reply(p, reply);
-  }
+  if (reply.line_loads.size() != n)
+    throw std::logic_error("stent contact: fill_reply needs a reply reset_reply() for the points of set_points()");
   reply.n_active = 0;
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
-  if (n == 0 || searches_.empty()) return;
-  Eval e;
-  evaluate_(model, false, e);  // every rank: identical data, no communication
-  for (size_t i = 0; i < n; ++i) {
+  const auto per_surface = evaluate_(model, points_, false);  // every rank: identical data, no communication
+  for (size_t i = 0; i < n && !per_surface.empty(); ++i) {
     contact::Vec3 q = contact::Vec3::Zero();
     int best = -1;
     double best_gap = std::numeric_limits<double>::infinity();
     bool active = false;
-    for (size_t k = 0; k < e.per_surface.size(); ++k) {
-      q += e.per_surface[k].q[i];
-      const auto& pc = e.per_surface[k].per_surface[0][i];
+    for (size_t k = 0; k < per_surface.size(); ++k) {
+      q += per_surface[k].q[i];
+      const auto& pc = per_surface[k].per_surface[0][i];
       if (!pc.found) continue;
       active = active || pc.active;
       if (pc.gap < best_gap) {
@@ -220,7 +165,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
     for (int c = 0; c < 3; ++c) reply.total_force[c] += points_[i].w * q(c);
     if (best >= 0) {
       // robin data: the plane of the surface with the smallest gap (only one plane per point is representable)
-      const auto& pc = e.per_surface[best].per_surface[0][i];
+      const auto& pc = per_surface[best].per_surface[0][i];
       reply.surface_points[i] = {pc.proj.s(0), pc.proj.s(1), pc.proj.s(2)};
       reply.normals[i] = {pc.proj.n(0), pc.proj.n(1), pc.proj.n(2)};
       reply.penalty[i] = penalty_[best];
@@ -258,7 +203,6 @@ PenaltySurfaceContact::~PenaltySurfaceContact() = default;
 
 void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
   const double t0 = MPI_Wtime();
-  allow_new_nonzeros(K);
   contact::ContactDiagnostics diag;
   double area = 0.0;
   // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything

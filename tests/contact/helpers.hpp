@@ -6,6 +6,8 @@
 #include <random>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "angio/contact/contact.hpp"
 
 namespace angio::contact::test {
@@ -179,6 +181,24 @@ inline Eigen::VectorXd assemble_dense(const std::vector<NodalContribution>& cont
           K->block<3, 3>(3 * c.nodes[a], 3 * c.nodes[b]) += c.K.block<3, 3>(3 * a, 3 * b);
     }
   return r;
+}
+
+// Checks an assembly r(u) (K: its tangent if non-null; `energy`: set by each call to the penalty potential)
+// by central differences with step 1e-6: K = dr/du and r = dPi/du, both to 1e-6 relative. r: the residual at u.
+inline void expect_fd_consistent(const std::function<Eigen::VectorXd(const Eigen::VectorXd&, Eigen::MatrixXd*)>& assemble,
+                                 const double& energy, const Eigen::VectorXd& u, Eigen::VectorXd& r) {
+  Eigen::MatrixXd K;
+  r = assemble(u, &K);
+  ASSERT_GT(r.norm(), 0.0);
+  const Eigen::MatrixXd Kfd = fd_jacobian([&](const Eigen::VectorXd& v) { return assemble(v, nullptr); }, u, 1e-6);
+  EXPECT_LT(rel_diff(K, Kfd), 1e-6);
+  const Eigen::MatrixXd rfd = fd_jacobian(
+      [&](const Eigen::VectorXd& v) {
+        assemble(v, nullptr);
+        return Eigen::VectorXd::Constant(1, energy);
+      },
+      u, 1e-6);
+  EXPECT_LT(rel_diff(r.transpose(), rfd), 1e-6);
 }
 
 }  // namespace angio::contact::test

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "angio/common/log.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
@@ -18,8 +20,9 @@ using namespace angio::solid;
 namespace {
 const std::string kConfigs = ANGIO_CONFIGS_DIR;
 
+// Per-process file name: the np1 and np2 variants of this test run at the same time under ctest -j.
 std::string write_scene(const std::string& name, const std::string& mesh_line) {
-  const auto path = std::filesystem::temp_directory_path() / name;
+  const auto path = std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + name);
   std::ofstream f(path);
   f << "time: {end: 1.0, steps: 1}\nballoon:\n  mesh: " << mesh_line
     << "\n  material: {E: 17.0, nu: 0.0}\n  pressure: 0.1\n";

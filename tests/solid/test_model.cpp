@@ -201,7 +201,8 @@ TEST(Model, OneAndTwoRanksGiveSameDisplacements) {
 
 // Scene -> runner -> HDF5/XDMF/summary.json on the communicator, two committed steps, one rejected.
 TEST(Runner, WritesOutputAndRollsBack) {
-  const std::string dir = "solid_runner_test_out";
+  // per rank count: solid.model.np1 and .np2 run this test concurrently in the same directory
+  const std::string dir = "solid_runner_test_out_np" + std::to_string(world_size());
   const std::string scene_file = std::string(ANGIO_SOLID_TEST_DATA) + "/small_artery.yaml";
   const auto root = angio::scene::load_scene(scene_file);
   SolidScene sc = read_solid_scene(root);

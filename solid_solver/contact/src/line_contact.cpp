@@ -13,6 +13,19 @@ void ContactDiagnostics::merge(const ContactDiagnostics& o) {
   energy += o.energy;
 }
 
+namespace {
+// Penalty law of LineContactParams at gap g: potential pi(g), force magnitude f = −dpi/dg and k = −df/dg
+// (linear law for g0 = 0, the g0 → 0 limit of the linear-quadratic one).
+struct PenaltyLaw {
+  double pi, f, k;
+};
+PenaltyLaw penalty_law(double g, double g0, double eps) {
+  if (g0 <= 0.0) return {0.5 * eps * g * g, -eps * g, eps};
+  if (g <= 0.0) return {eps * (0.5 * g * g - 0.5 * g0 * g + g0 * g0 / 6.0), eps * (0.5 * g0 - g), eps};
+  return {eps * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0), 0.5 * eps * (g0 - g) * (g0 - g) / g0, eps * (g0 - g) / g0};
+}
+}  // namespace
+
 void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, double normal_sign, const Projection& proj,
                        const LineContactParams& par, PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K) {
   const int nn = num_nodes(kind);
@@ -22,17 +35,13 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
   pc.active = pc.gap < g0;
   pc.q.setZero();
   pc.dq_dx.setZero();
+  pc.energy = 0.0;
   r.setZero(3 * nn);
   if (K) K->setZero(3 * nn, 3 * nn);
   if (!pc.active) return;
-  const double eps = par.penalty, g = pc.gap, w = bp.w;
-  // force magnitude f(g) = −dπ/dg and k(g) = −df/dg of the penalty law (linear, or linear-
-  // quadratic for g0 > 0); the linear law is the g0 → 0 limit: f = −eps g, k = eps.
-  double f = -eps * g, k = eps;
-  if (g0 > 0.0) {
-    f = g <= 0.0 ? eps * (0.5 * g0 - g) : 0.5 * eps * (g0 - g) * (g0 - g) / g0;
-    k = g <= 0.0 ? eps : eps * (g0 - g) / g0;
-  }
+  const double w = bp.w;
+  const auto [pi, f, k] = penalty_law(pc.gap, g0, par.penalty);
+  pc.energy = w * pi;
   pc.q = f * proj.n;
   const bool need_h = K != nullptr || par.beam_tangent;
   GapLinearization L;
@@ -79,12 +88,7 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::
       res.force_on_beam += bp.w * pc.q;
       res.diag.force_on_solid -= bp.w * pc.q;
       res.diag.force_magnitude += bp.w * pc.q.norm();
-      {  // penalty potential π(g) of the law in line_point_kernel
-        const double g = pc.gap, g0 = par.regularization, e = par.penalty;
-        res.diag.energy += bp.w * (g0 <= 0.0 ? 0.5 * e * g * g
-                                   : g <= 0.0 ? e * (0.5 * g * g - 0.5 * g0 * g + g0 * g0 / 6.0)
-                                              : e * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0));
-      }
+      res.diag.energy += pc.energy;
       nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + face.nn());
       nc.surface = static_cast<int>(k);
       nc.point = static_cast<int>(i);

@@ -6,12 +6,20 @@
 #include <string>
 #include <vector>
 
+#include "angio/contact/face.hpp"
 #include "angio/solid/materials.hpp"
 
 namespace angio::solid {
 
 enum class ElemType { Hex8, Tet4, Tet10 };
 enum class FaceType { Quad4, Tri3, Tri6 };
+
+// The same face as a contact face kind (the face shape functions live in angio::contact).
+inline contact::FaceKind to_contact(FaceType t) {
+  static_assert(int(FaceType::Quad4) == int(contact::FaceKind::Quad4) &&
+                int(FaceType::Tri3) == int(contact::FaceKind::Tri3) && int(FaceType::Tri6) == int(contact::FaceKind::Tri6));
+  return contact::FaceKind(int(t));
+}
 
 int num_nodes(ElemType t);
 int num_nodes(FaceType t);

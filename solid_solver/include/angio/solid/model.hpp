@@ -123,6 +123,8 @@ class SolidModel {
   void setup_petsc_();
   void apply_dirichlet_values_();
   void gather_(Vec v, std::vector<double>& full);
+  // Faces of surface set `name` assembled by this rank (those whose first node it owns); `what` names the load.
+  std::vector<Face> owned_faces_(const std::string& name, const char* what) const;
 
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
@@ -132,13 +134,10 @@ class SolidModel {
   std::vector<std::vector<FiberFamily>> fibers_;  // per element
   std::vector<int> elem_rank_, node_owner_, perm_, iperm_, local_elements_;
   int node_begin_ = 0, node_end_ = 0;
-  struct LocalFaces {
-    std::vector<Face> faces;
-  };
   std::vector<PressureLoad> pressures_;
-  std::vector<LocalFaces> pressure_faces_;
+  std::vector<std::vector<Face>> pressure_faces_;  // per load: the faces this rank assembles
   std::vector<SpringSupport> springs_;
-  std::vector<LocalFaces> spring_faces_;
+  std::vector<std::vector<Face>> spring_faces_;
   std::vector<DirichletBC> dirichlet_;
   std::vector<PetscInt> dirichlet_rows_;  // owned global rows
   ContactModel* contact_ = nullptr;
@@ -146,8 +145,7 @@ class SolidModel {
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
   Mat K_ = nullptr;
-  Vec r_ = nullptr, du_ = nullptr, rtrial_ = nullptr;
-  Mat Ktrial_ = nullptr;
+  Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;
   VecScatter scatter_ = nullptr;
   Vec full_ = nullptr;

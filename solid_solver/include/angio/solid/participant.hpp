@@ -24,6 +24,10 @@ class StentContact : public ContactModel {
   virtual void fill_reply(const SolidModel& model, participant::ContactReply& reply) = 0;
 };
 
+// A contact-free reply for `points` (zero line loads, surface points = the points, inactive); SolidRunner::solve
+// starts every reply with it before the stent contact fills it.
+void reset_reply(const participant::SamplePoints& points, participant::ContactReply& reply);
+
 // Per committed step summary (written to <run-dir>/solid/summary.json).
 struct StepSummary {
   int step = 0;

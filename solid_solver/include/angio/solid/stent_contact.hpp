@@ -20,6 +20,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -74,8 +75,9 @@ class PenaltyStentContact : public StentContact {
   std::size_t num_points() const { return points_.size(); }
 
  private:
-  struct Eval;
-  void evaluate_(const SolidModel& model, bool tangent, Eval& out);
+  // Updates the searches to the current configuration and evaluates `points` against each surface (own penalty).
+  std::vector<contact::LineContactResult> evaluate_(const SolidModel& model, std::span<const contact::BeamPoint> points,
+                                                    bool tangent);
 
   Options opt_;
   std::vector<std::string> names_;
@@ -132,8 +134,5 @@ class CompositeContact : public StentContact {
   PenaltyStentContact* stent_ = nullptr;
   std::vector<ContactModel*> others_;
 };
-
-// Helpers shared with the tests: fill a contact-free reply (as SolidRunner::solve does).
-void reset_reply(const participant::SamplePoints& points, participant::ContactReply& reply);
 
 }  // namespace angio::solid

@@ -50,6 +50,7 @@ struct PointContact {
   Projection proj;          // s, n (toward the beam), xi, location
   double gap = 0.0;         // g = (x - s).n - R (only if found)
   Vec3 q = Vec3::Zero();    // line load on the beam (N/mm)
+  double energy = 0.0;      // penalty potential w pi(g) of this pair (N mm)
   Mat3 dq_dx = Mat3::Zero();// dq/dx with the surface fixed (if beam_tangent)
 };
 
