@@ -41,25 +41,9 @@ template <class T>
 Q<T> qsmall(const T* th) {
   return {T(1.0), th[0] * 0.5, th[1] * 0.5, th[2] * 0.5};
 }
-// Rotates v by q^T (q unit): v' = Λᵀ v.
-template <class T>
-void rotate_transpose(const Q<T>& q, const T* v, T* out) {
-  // u = vector part of conj(q) = -q.v; v' = v + 2w (u×v) + 2 u×(u×v)
-  T ux = -q.x, uy = -q.y, uz = -q.z;
-  T cx = uy * v[2] - uz * v[1];
-  T cy = uz * v[0] - ux * v[2];
-  T cz = ux * v[1] - uy * v[0];
-  T ccx = uy * cz - uz * cy;
-  T ccy = uz * cx - ux * cz;
-  T ccz = ux * cy - uy * cx;
-  out[0] = v[0] + 2.0 * (q.w * cx) + 2.0 * ccx;
-  out[1] = v[1] + 2.0 * (q.w * cy) + 2.0 * ccy;
-  out[2] = v[2] + 2.0 * (q.w * cz) + 2.0 * ccz;
-}
-
 // Relative rotation of the two element triads (Crisfield–Jelenić): φ = log(Λ1ᵀΛ2) (in the Λ1
 // frame) and the reference triad Λ_r = Λ1 exp(φ/2), with sqrt(q) = normalize(1 + q) for the
-// shortest-arc quaternion. Shared by the strain and the rotation kernels.
+// shortest-arc quaternion.
 template <class T>
 void relative_rotation(const Q<T>& L1, const Q<T>& L2, T* phi, Q<T>& qr) {
   using std::sqrt;
@@ -81,43 +65,6 @@ void relative_rotation(const Q<T>& L1, const Q<T>& L2, T* phi, Q<T>& qr) {
   phi[1] = 2.0 * f * rel.y;
   phi[2] = 2.0 * f * rel.z;
   qr = qmul(L1, qnormalize(Q<T>{rel.w + 1.0, rel.x, rel.y, rel.z}));
-}
-
-// Strain (Γ, Ω) without the reference subtraction, for perturbations p (12 variables, order
-// x1, θ1, x2, θ2) applied as x + p, Λ = (I + ½ p̂θ...) Λ; pe and pd are two sets combined as
-// exp(pe) exp(pd) Λ.
-template <class T>
-void strains_raw(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
-                 const Quat& R2, const T* pe, const T* pd, T* S, Q<T>* qr_out = nullptr) {
-  Q<T> L1 = qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R1 * ref.O1));
-  Q<T> L2 = qmul(qmul(qsmall(pe + 9), qsmall(pd + 9)), qconst<T>(R2 * ref.O2));
-  L1 = qnormalize(L1);
-  L2 = qnormalize(L2);
-  T phi[3];
-  Q<T> qr;
-  relative_rotation(L1, L2, phi, qr);
-  const double iL = 1.0 / ref.L0;
-  S[3] = phi[0] * iL;
-  S[4] = phi[1] * iL;
-  S[5] = phi[2] * iL;
-  T d[3];
-  for (int i = 0; i < 3; ++i) d[i] = (T(x2(i)) + pe[6 + i] + pd[6 + i] - T(x1(i)) - pe[i] - pd[i]) * iL;
-  T g[3];
-  rotate_transpose(qr, d, g);
-  S[0] = g[0] - 1.0;
-  S[1] = g[1];
-  S[2] = g[2];
-  if (qr_out) *qr_out = qr;
-}
-
-Vec6 raw_strain_double(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
-                       const Quat& R2) {
-  double z[12] = {0};
-  double S[6];
-  strains_raw<double>(ref, x1, x2, R1, R2, z, z, S);
-  Vec6 out;
-  for (int i = 0; i < 6; ++i) out(i) = S[i];
-  return out;
 }
 
 // Rotation part only: perturbations of the two nodal rotations (6 variables each set).
@@ -144,6 +91,26 @@ void rotation_kernel(const ElementReference& ref, const Quat& R1, const Quat& R2
   Qm[5] = Qm[5] + wx;
   Qm[6] = Qm[6] + wy;
   Qm[7] = Qm[7] - wx;
+}
+
+// Convected strain (Γ, Ω) before subtracting the reference strains (Γ0, Ω0): the value part of
+// evaluate_element's computation, with the same arithmetic.
+Vec6 raw_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
+                const Quat& R2) {
+  const double z[6] = {0, 0, 0, 0, 0, 0};
+  double phi[3], Qm[9];
+  rotation_kernel<double>(ref, R1, R2, z, z, phi, Qm);
+  const double iL = 1.0 / ref.L0;
+  const Vec3 d0 = x2 - x1;
+  Vec6 s;
+  for (int k = 0; k < 3; ++k) {
+    double g = 0;
+    for (int j = 0; j < 3; ++j) g += Qm[3 * k + j] * d0(j);
+    s(k) = g * iL;
+    s(3 + k) = phi[k] * iL;
+  }
+  s(0) -= 1.0;
+  return s;
 }
 
 }  // namespace
@@ -186,7 +153,7 @@ ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Qu
   ref.L0 = (X2 - X1).norm();
   ref.O1 = O1.normalized();
   ref.O2 = O2.normalized();
-  Vec6 s = raw_strain_double(ref, X1, X2, Quat::Identity(), Quat::Identity());
+  Vec6 s = raw_strain(ref, X1, X2, Quat::Identity(), Quat::Identity());
   ref.Gamma0 = s.head<3>();
   ref.Omega0 = s.tail<3>();
   return ref;
@@ -194,18 +161,10 @@ ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Qu
 
 Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
                     const Quat& R2) {
-  Vec6 s = raw_strain_double(ref, x1, x2, R1, R2);
+  Vec6 s = raw_strain(ref, x1, x2, R1, R2);
   s.head<3>() -= ref.Gamma0;
   s.tail<3>() -= ref.Omega0;
   return s;
-}
-
-Quat element_midpoint_triad(const ElementReference& ref, const Quat& R1, const Quat& R2) {
-  double z[12] = {0};
-  double S[6];
-  Q<double> qr;
-  strains_raw<double>(ref, Vec3::Zero(), Vec3::UnitX(), R1, R2, z, z, S, &qr);
-  return Quat(qr.w, qr.x, qr.y, qr.z).normalized();
 }
 
 ElementResult evaluate_element(const Section& sec, const ElementReference& ref, const Vec3& x1,

@@ -2,8 +2,6 @@
 //   beam_solver --scene FILE --run-dir DIR                       beam-only scene (standalone loop)
 //   beam_solver --scene FILE --run-dir DIR --endpoint E --run-id ID   co-simulation (serves the
 //                                                                      beam role to the coupler)
-#include <cstdio>
-#include <exception>
 #include <filesystem>
 
 #include "angio/beam/participant.hpp"
@@ -21,16 +19,9 @@ int main(int argc, char** argv) {
                          "bending.\nWithout --endpoint the scene is solved standalone (beam-only "
                          "scene); with --endpoint the beam role is served to the coupler.");
   cli.add_common();
-  try {
-    if (!cli.parse(argc, argv)) return 0;
+  return angio::cli::run_main(cli, argc, argv, [&] {
     angio::cli::setup_logging(cli, "beam");
-    if (!cli.has("scene") || cli.get("scene").empty())
-      throw angio::cli::UsageError("--scene FILE is required");
-  } catch (const angio::cli::UsageError& e) {
-    std::fprintf(stderr, "beam_solver: %s\n%s", e.what(), cli.usage().c_str());
-    return 2;
-  }
-  try {
+    angio::cli::require(cli, {"scene"});
     angio::beam::BeamScene scene = angio::beam::load_beam_scene(cli.get("scene"));
     const std::string run_dir = cli.get("run-dir");
     std::filesystem::create_directories(run_dir);
@@ -43,16 +34,9 @@ int main(int argc, char** argv) {
       const auto o = angio::participant::serve_options(cli, "beam_solver 0.1");
       return angio::participant::serve(beam, o);
 #else
-      LOG_ERROR("this beam_solver was built without the zenoh transport; --endpoint unsupported");
-      return 2;
+      throw angio::cli::UsageError("this beam_solver was built without the zenoh transport; --endpoint unsupported");
 #endif
     }
     return angio::participant::run_standalone(beam, time);
-  } catch (const angio::scene::SceneError& e) {
-    LOG_ERROR(e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    LOG_ERROR("beam_solver: " << e.what());
-    return 1;
-  }
+  });
 }

@@ -1,12 +1,12 @@
 #include "angio/beam/model.hpp"
 
+#include "angio/common/clock.hpp"
+#include "angio/common/log.hpp"
 #include "angio/participant/plane_penalty.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 namespace angio::beam {
@@ -110,11 +110,11 @@ int BeamModel::add_element(int n1, int n2, int section, const Quat& O1, const Qu
 void BeamModel::fix(int node, const std::array<bool, 6>& f) {
   for (int i = 0; i < 6; ++i) fixed_.at(node)[i] = fixed_.at(node)[i] || f[i];
 }
-void BeamModel::set_basis(int node, const Mat3& B) { basis_.at(node) = B; }
 
 namespace {
-Mat3 cylindrical_basis(const Axis& axis, const Vec3& X) {
-  const auto p = axis.project(X);
+// Translation basis (radial, circumferential, axial) at a point projected onto the axis; on the
+// axis the radial direction is an arbitrary normal.
+Mat3 cylindrical_basis(const Axis::Projection& p) {
   Mat3 B;
   if (p.r > 0) {
     B.col(0) = p.radial;
@@ -127,23 +127,15 @@ Mat3 cylindrical_basis(const Axis& axis, const Vec3& X) {
 }
 }  // namespace
 
-// Local translation basis of such nodes: (radial, circumferential, axial).
-void BeamModel::fix_radial_only(int node) {
-  if (axis.project(X_.at(node)).r <= 0) throw std::invalid_argument("radial fixation of a node on the axis");
-  basis_[node] = cylindrical_basis(axis, X_[node]);
-  fixed_[node][1] = fixed_[node][2] = true;
-}
-
-void BeamModel::fix_axial(int node) {
-  basis_[node] = cylindrical_basis(axis, X_.at(node));
-  fixed_[node][2] = true;
-}
-
-void BeamModel::fix_circumferential(int node) {
-  if (axis.project(X_.at(node)).r <= 0)
-    throw std::invalid_argument("circumferential fixation of a node on the axis");
-  basis_[node] = cylindrical_basis(axis, X_[node]);
-  fixed_[node][1] = true;
+// Circumferential fixation (alone or with the axial one: radial-only motion) needs the node's
+// radial direction, i.e. a node off the axis.
+void BeamModel::fix_cylindrical(int node, bool circumferential, bool axial) {
+  const auto p = axis.project(X_.at(node));
+  if (circumferential && p.r <= 1e-12)
+    throw std::invalid_argument("node " + std::to_string(node) + " lies on the device axis");
+  basis_[node] = cylindrical_basis(p);
+  fixed_[node][1] = fixed_[node][1] || circumferential;
+  fixed_[node][2] = fixed_[node][2] || axial;
 }
 
 void BeamModel::finalize() {
@@ -176,6 +168,12 @@ void BeamModel::finalize() {
   }
   identity_basis_.assign(n, 1);
   for (int i = 0; i < n; ++i) identity_basis_[i] = basis_[i].isIdentity(0.0) ? 1 : 0;
+  elem_dofs_.resize(12 * static_cast<size_t>(num_elements()));
+  for (int e = 0; e < num_elements(); ++e)
+    for (int k = 0; k < 6; ++k) {
+      elem_dofs_[12 * e + k] = free_[elem_nodes_[e][0]][k];
+      elem_dofs_[12 * e + 6 + k] = free_[elem_nodes_[e][1]][k];
+    }
   pattern_ = SpMat();
   elem_pos_.clear();
   lin_.reset();
@@ -230,10 +228,16 @@ std::vector<Vec3> BeamModel::sample_load_nodal_forces() const {
   return f;
 }
 
-double BeamModel::diameter() const {
+double BeamModel::diameter(bool reference) const {
   double s = 0;
-  for (const auto& x : x_) s += axis.project(x).r;
+  for (const auto& x : reference ? X_ : x_) s += axis.project(x).r;
   return 2.0 * s / std::max(1, num_nodes());
+}
+double BeamModel::diameter(const std::vector<int>& nodes, bool reference) const {
+  const auto& pos = reference ? X_ : x_;
+  double s = 0;
+  for (int n : nodes) s += axis.project(pos.at(n)).r;
+  return nodes.empty() ? 0.0 : 2.0 * s / nodes.size();
 }
 
 void BeamModel::set_time(double t) {
@@ -252,53 +256,64 @@ void BeamModel::set_state(const std::vector<Vec3>& x, const std::vector<Quat>& R
   R_ = R;
 }
 
-Mat12 BeamModel::element_transform(int e) const {
-  Mat12 T = Mat12::Identity();
-  T.block<3, 3>(0, 0) = basis_[elem_nodes_[e][0]];
-  T.block<3, 3>(6, 6) = basis_[elem_nodes_[e][1]];
-  return T;
+void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
+  Eigen::VectorXd rg;
+  assemble_global(K, rg);
+  // reduce the residual to the free DOFs in the nodes' bases
+  r.setZero(nfree_);
+  for (int n = 0; n < num_nodes(); ++n) {
+    const Vec3 rt = basis_[n].transpose() * rg.segment<3>(6 * n);
+    for (int k = 0; k < 3; ++k) {
+      if (free_[n][k] >= 0) r(free_[n][k]) = rt(k);
+      if (free_[n][3 + k] >= 0) r(free_[n][3 + k]) = rg(6 * n + 3 + k);
+    }
+  }
 }
 
-void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
+Eigen::VectorXd BeamModel::global_residual() {
+  Eigen::VectorXd rg;
+  assemble_global(nullptr, rg);
+  return rg;
+}
+
+void BeamModel::assemble_global(SpMat* K, Eigen::VectorXd& rg) {
   if (nfree_ < 0) throw std::logic_error("BeamModel::finalize() not called");
   const int ne = num_elements();
-  Eigen::VectorXd rg = Eigen::VectorXd::Zero(6 * num_nodes());
-  std::vector<Eigen::Triplet<double>> trip;
-  if (K && elem_pos_.empty()) trip.reserve(static_cast<size_t>(ne) * 144);
+  rg.setZero(6 * num_nodes());
   // distributed loads at this time
-  std::vector<Vec3> eq(ne, Vec3::Zero());
-  std::vector<double> ep(ne, 0.0), epd(ne, 0.0);  // follower and dead radial loads
+  elem_q_.assign(ne, Vec3::Zero());
+  elem_p_follower_.assign(ne, 0.0);
+  elem_p_dead_.assign(ne, 0.0);
   for (const auto& l : line_loads) {
     const Vec3 q = l.q * l.curve(time_);
     if (l.elements.empty())
-      for (auto& v : eq) v += q;
+      for (auto& v : elem_q_) v += q;
     else
-      for (int e : l.elements) eq.at(e) += q;
+      for (int e : l.elements) elem_q_.at(e) += q;
   }
   for (const auto& l : radial_loads) {
     const double p = l.p * l.curve(time_);
-    auto& tgt = l.follower ? ep : epd;
+    auto& tgt = l.follower ? elem_p_follower_ : elem_p_dead_;
     if (l.elements.empty())
       for (auto& v : tgt) v += p;
     else
       for (int e : l.elements) tgt.at(e) += p;
   }
   const int ng = sample_points_per_element;
-  std::vector<int> elem_idx(static_cast<size_t>(ne) * 12);
-  for (int e = 0; e < ne; ++e)
-    for (int k = 0; k < 6; ++k) {
-      elem_idx[12 * e + k] = free_[elem_nodes_[e][0]][k];
-      elem_idx[12 * e + 6 + k] = free_[elem_nodes_[e][1]][k];
-    }
+  // The first assembly with a tangent collects triplets and builds the pattern; later ones add
+  // into the pattern's values at the positions found then.
   const bool first_pattern = K && elem_pos_.empty();
+  std::vector<Eigen::Triplet<double>> trip;
+  if (first_pattern) trip.reserve(static_cast<size_t>(ne) * 144);
   double* vals = nullptr;
   if (K && !first_pattern) {
     *K = pattern_;
     vals = K->valuePtr();
     std::fill(vals, vals + K->nonZeros(), 0.0);
   }
-  auto scatter = [&](int e, const int* idx, const Mat12& Km) {
+  auto scatter = [&](int e, const Mat12& Km) {
     if (first_pattern) {
+      const int* idx = &elem_dofs_[12 * static_cast<size_t>(e)];
       for (int i = 0; i < 12; ++i) {
         if (idx[i] < 0) continue;
         for (int j = 0; j < 12; ++j)
@@ -313,50 +328,47 @@ void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
   };
   // Element kernels are independent: evaluate them in parallel (OpenMP, when available), then
   // add loads and scatter serially.
-  std::vector<ElementResult> evs(ne);
+  elem_results_.resize(ne);
 #ifdef _OPENMP
 #pragma omp parallel for schedule(static) if (ne >= 64)
 #endif
   for (int e = 0; e < ne; ++e) {
     const auto [a, b] = elem_nodes_[e];
-    evs[e] = evaluate_element(sections_[elem_section_[e]], eref_[e], x_[a], x_[b], R_[a], R_[b],
-                              mp_committed_[e], K != nullptr);
+    elem_results_[e] = evaluate_element(sections_[elem_section_[e]], eref_[e], x_[a], x_[b], R_[a], R_[b],
+                                        mp_committed_[e], K != nullptr);
   }
   for (int e = 0; e < ne; ++e) {
     const auto [a, b] = elem_nodes_[e];
-    ElementResult& ev = evs[e];
+    ElementResult& ev = elem_results_[e];
     mp_trial_[e] = ev.section.state;
     mnorm_[e] = ev.section.bending_moment_norm;
     stress_[e] = ev.section.stress;
     Vec12& re = ev.residual;
     Mat12& Ke = ev.tangent;
+    // load stiffness of a sample point's line load q(x), x = N1 x_a + N2 x_b
+    auto add_load_stiffness = [&](double N1, double N2, double w, const Mat3& dq_dx) {
+      Ke.block<3, 3>(0, 0) -= N1 * N1 * w * dq_dx;
+      Ke.block<3, 3>(0, 6) -= N1 * N2 * w * dq_dx;
+      Ke.block<3, 3>(6, 0) -= N2 * N1 * w * dq_dx;
+      Ke.block<3, 3>(6, 6) -= N2 * N2 * w * dq_dx;
+    };
     for (int k = 0; k < ng; ++k) {
       const int g = e * ng + k;
       const double N2 = gauss_xi_[k], N1 = 1.0 - N2;
       const double w = gauss_w_[k] * eref_[e].L0;
-      Vec3 q = q_ext_[g] + eq[e] + epd[e] * ref_radial_[g];
+      Vec3 q = q_ext_[g] + elem_q_[e] + elem_p_dead_[e] * ref_radial_[g];
       if (!planes_.empty() && planes_[g].eps > 0.0) {
         const participant::PlanePenalty pp = participant::plane_penalty(N1 * x_[a] + N2 * x_[b], planes_[g].s, planes_[g].n,
                                               planes_[g].eps, sections_[elem_section_[e]].contact_radius, planes_[g].g0);
         q += pp.q;
-        if (K && pp.gap < planes_[g].g0) {
-          Ke.block<3, 3>(0, 0) -= N1 * N1 * w * pp.dq_dx;
-          Ke.block<3, 3>(0, 6) -= N1 * N2 * w * pp.dq_dx;
-          Ke.block<3, 3>(6, 0) -= N2 * N1 * w * pp.dq_dx;
-          Ke.block<3, 3>(6, 6) -= N2 * N2 * w * pp.dq_dx;
-        }
+        if (K) add_load_stiffness(N1, N2, w, pp.dq_dx);  // zero where the point is free
       }
-      if (ep[e] != 0.0) {
-        const Vec3 xg = N1 * x_[a] + N2 * x_[b];
-        const auto pr = axis.project(xg);
-        q += ep[e] * pr.radial;
+      if (const double p = elem_p_follower_[e]; p != 0.0) {
+        const auto pr = axis.project(N1 * x_[a] + N2 * x_[b]);
+        q += p * pr.radial;
         if (K && pr.r > 0) {
           const Mat3 P = Mat3::Identity() - pr.tangent * pr.tangent.transpose();
-          const Mat3 dq = ep[e] / pr.r * (P - pr.radial * pr.radial.transpose());
-          Ke.block<3, 3>(0, 0) -= N1 * N1 * w * dq;
-          Ke.block<3, 3>(0, 6) -= N1 * N2 * w * dq;
-          Ke.block<3, 3>(6, 0) -= N2 * N1 * w * dq;
-          Ke.block<3, 3>(6, 6) -= N2 * N2 * w * dq;
+          add_load_stiffness(N1, N2, w, p / pr.r * (P - pr.radial * pr.radial.transpose()));
         }
       }
       re.segment<3>(0) -= N1 * w * q;
@@ -365,26 +377,32 @@ void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
     rg.segment<6>(6 * a) += re.segment<6>(0);
     rg.segment<6>(6 * b) += re.segment<6>(6);
     if (K) {
-      const int* idx = &elem_idx[12 * e];
-      if (identity_basis_[a] && identity_basis_[b]) {
-        scatter(e, idx, Ke);
-      } else {
-        const Mat12 T = element_transform(e);
-        const Mat12 Kl = T.transpose() * Ke * T;
-        scatter(e, idx, Kl);
+      // translations of a node with a local basis B: K ← Tᵀ K T, T = diag(B_a, I, B_b, I)
+      for (int side = 0; side < 2; ++side) {
+        const int n = elem_nodes_[e][side];
+        if (identity_basis_[n]) continue;
+        Ke.middleRows<3>(6 * side) = basis_[n].transpose() * Ke.middleRows<3>(6 * side);
+        Ke.middleCols<3>(6 * side) = Ke.middleCols<3>(6 * side) * basis_[n];
       }
+      scatter(e, Ke);
     }
   }
-  if (K && first_pattern) {
+  for (const auto& l : nodal_loads) {
+    const double c = l.curve(time_);
+    rg.segment<3>(6 * l.node) -= c * l.force;
+    rg.segment<3>(6 * l.node + 3) -= c * l.moment;
+  }
+  if (first_pattern) {
     pattern_.resize(nfree_, nfree_);
     pattern_.setFromTriplets(trip.begin(), trip.end());
     pattern_.makeCompressed();
+    *K = pattern_;
     // positions of every element entry in the compressed pattern, for the next assemblies
     elem_pos_.assign(static_cast<size_t>(ne) * 144, -1);
     const int* outer = pattern_.outerIndexPtr();
     const int* inner = pattern_.innerIndexPtr();
     for (int e = 0; e < ne; ++e) {
-      const int* idx = &elem_idx[12 * e];
+      const int* idx = &elem_dofs_[12 * static_cast<size_t>(e)];
       for (int i = 0; i < 12; ++i) {
         if (idx[i] < 0) continue;
         for (int j = 0; j < 12; ++j) {
@@ -398,42 +416,6 @@ void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
       }
     }
   }
-  for (const auto& l : nodal_loads) {
-    const double c = l.curve(time_);
-    rg.segment<3>(6 * l.node) -= c * l.force;
-    rg.segment<3>(6 * l.node + 3) -= c * l.moment;
-  }
-  r.setZero(nfree_);
-  for (int n = 0; n < num_nodes(); ++n) {
-    const Vec3 rt = basis_[n].transpose() * rg.segment<3>(6 * n);
-    for (int k = 0; k < 3; ++k) {
-      if (free_[n][k] >= 0) r(free_[n][k]) = rt(k);
-      if (free_[n][3 + k] >= 0) r(free_[n][3 + k]) = rg(6 * n + 3 + k);
-    }
-  }
-  if (K && first_pattern) {
-    K->resize(nfree_, nfree_);
-    K->setFromTriplets(trip.begin(), trip.end());
-    K->makeCompressed();
-  }
-}
-
-Eigen::VectorXd BeamModel::global_residual() {
-  // temporarily treat all DOFs as free in the global basis
-  auto free_save = free_;
-  auto basis_save = basis_;
-  int nfree_save = nfree_;
-  nfree_ = 0;
-  for (int n = 0; n < num_nodes(); ++n) {
-    basis_[n] = Mat3::Identity();
-    for (int k = 0; k < 6; ++k) free_[n][k] = nfree_++;
-  }
-  Eigen::VectorXd r;
-  assemble(nullptr, r);
-  free_ = free_save;
-  basis_ = basis_save;
-  nfree_ = nfree_save;
-  return r;
 }
 
 void BeamModel::apply_increment(const Eigen::VectorXd& d, double alpha) {
@@ -460,18 +442,8 @@ void BeamModel::restore() {
   mp_trial_ = mp_committed_;
 }
 
-namespace {
-std::string history_text(const std::vector<double>& h) {
-  std::ostringstream os;
-  os.precision(3);
-  os << std::scientific;
-  for (size_t i = 0; i < h.size(); ++i) os << (i ? ", " : "") << h[i];
-  return os.str();
-}
-}  // namespace
-
 NewtonStats BeamModel::solve() {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   NewtonStats st;
   if (!lin_) lin_ = make_linear_solver(newton.linear_solver);
   SpMat K;
@@ -484,13 +456,15 @@ NewtonStats BeamModel::solve() {
     st.converged = ok;
     st.residual = rn;
     st.message = msg;
-    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    st.seconds = seconds_since(t0);
     return st;
   };
   if (!std::isfinite(rn)) return finish(false, "residual is NaN/Inf at the start of the solve");
   const double rtol = std::max(newton.residual_tol, newton.residual_rel_tol * r0);
   if (rn <= newton.residual_tol) return finish(true, "");
   double dn = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd rnew;
+  SpMat Knew;
   for (int it = 1; it <= newton.max_iterations; ++it) {
     Eigen::VectorXd d;
     try {
@@ -498,15 +472,13 @@ NewtonStats BeamModel::solve() {
     } catch (const std::exception& e) {
       return finish(false, std::string("linear solve failed in iteration ") + std::to_string(it) +
                                ": " + e.what() + "; residual history: " +
-                               history_text(st.residual_history));
+                               log::list(st.residual_history));
     }
     if (!d.allFinite())
       return finish(false, "Newton increment is NaN/Inf in iteration " + std::to_string(it));
     const auto xs = x_;
     const auto Rs = R_;
     double alpha = 1.0;
-    Eigen::VectorXd rnew;
-    SpMat Knew;
     for (int ls = 0;; ++ls) {
       apply_increment(d, alpha);
       assemble(&Knew, rnew);
@@ -528,8 +500,8 @@ NewtonStats BeamModel::solve() {
       R_ = Rs;
       alpha *= 0.5;
     }
-    K = std::move(Knew);
-    r = std::move(rnew);
+    std::swap(K, Knew);  // Knew keeps its storage for the next assembly
+    std::swap(r, rnew);
     rn = r.norm();
     dn = alpha * d.norm();
     st.iterations = it;
@@ -538,13 +510,13 @@ NewtonStats BeamModel::solve() {
     if (rn > 1e8 * std::max(r0, newton.residual_tol))
       return finish(false, "Newton diverged in iteration " + std::to_string(it) +
                                " (residual grew by more than 1e8); residual history: " +
-                               history_text(st.residual_history));
+                               log::list(st.residual_history));
     if (rn <= rtol && dn <= newton.increment_tol) return finish(true, "");
     // round-off floor: increment negligible and residual within 100× the tolerance
     if (dn <= 1e-3 * newton.increment_tol && rn <= 100.0 * rtol) return finish(true, "");
   }
   return finish(false, "Newton did not converge in " + std::to_string(newton.max_iterations) +
-                           " iterations; residual history: " + history_text(st.residual_history) +
+                           " iterations; residual history: " + log::list(st.residual_history) +
                            "; last increment " + std::to_string(dn));
 }
 

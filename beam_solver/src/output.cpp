@@ -194,13 +194,7 @@ std::string write_summary(const std::string& path, const BeamModel& m,
   os << "  \"units\": {\"length\": \"mm\", \"force\": \"N\", \"moment\": \"N mm\", \"time\": \"s\"},\n";
   os << "  \"num_nodes\": " << m.num_nodes() << ",\n  \"num_elements\": " << m.num_elements() << ",\n";
   os << "  \"generated_stent\": " << (generated_stent ? "true" : "false") << ",\n";
-  double D0 = 0;
-  {
-    // initial (crimped) diameter from the reference positions
-    double s = 0;
-    for (int n = 0; n < m.num_nodes(); ++n) s += m.axis.project(m.reference_position(n)).r;
-    D0 = 2 * s / std::max(1, m.num_nodes());
-  }
+  const double D0 = m.diameter(true);  // initial (crimped) diameter
   double Dmax = D0, tmax = 0;
   for (const auto& s : steps)
     if (s.diameter > Dmax) {

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 
 namespace angio::beam {
@@ -34,17 +35,11 @@ BeamSolverParticipant::~BeamSolverParticipant() = default;
 void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const {
   const BeamModel& m = *scene_.model;
   if (!scene_.stent) return;
-  auto pos = [&](int n) { return reference ? m.reference_position(n) : m.position(n); };
-  auto diam = [&](const std::vector<int>& nodes) {
-    double s = 0;
-    for (int n : nodes) s += m.axis.project(pos(n)).r;
-    return nodes.empty() ? 0.0 : 2.0 * s / nodes.size();
-  };
-  r.distal_diameter = diam(scene_.stent->distal_nodes);
-  r.central_diameter = diam(scene_.stent->central_nodes);
+  r.distal_diameter = m.diameter(scene_.stent->distal_nodes, reference);
+  r.central_diameter = m.diameter(scene_.stent->central_nodes, reference);
   double smin = 1e300, smax = -1e300;
   for (int n = 0; n < m.num_nodes(); ++n) {
-    const double s = m.axis.project(pos(n)).s;
+    const double s = m.axis.project(reference ? m.reference_position(n) : m.position(n)).s;
     smin = std::min(smin, s);
     smax = std::max(smax, s);
   }
@@ -72,7 +67,7 @@ void BeamSolverParticipant::begin_step(int step, double time) {
   time_ = time;
   step_iterations_ = 0;
   step_residual_ = 0;
-  step_start_ = std::chrono::steady_clock::now();
+  step_start_ = Clock::now();
   scene_.model->set_time(time);
   LOG_DEBUG("begin step " << step << " t = " << time);
 }
@@ -133,14 +128,8 @@ participant::SolveStats BeamSolverParticipant::solve_loads_(const std::vector<pa
     os << "beam Newton failed at step " << step_ << ", t = " << time_ << " s: " << st.message;
     out.message = os.str();
   }
-  if (log::enabled(log::Level::debug)) {
-    std::ostringstream os;
-    os << std::scientific << std::setprecision(2);
-    for (size_t i = 0; i < st.residual_history.size(); ++i)
-      os << (i ? " " : "") << st.residual_history[i];
-    LOG_DEBUG("beam solve step " << step_ << ": " << st.iterations << " iterations, residuals [" << os.str()
-                                 << "], " << st.seconds << " s");
-  }
+  LOG_DEBUG("beam solve step " << step_ << ": " << st.iterations << " iterations, residuals "
+                               << log::list(st.residual_history) << ", " << st.seconds << " s");
   return out;
 }
 
@@ -161,7 +150,7 @@ void BeamSolverParticipant::end_step(bool accept) {
                step_iterations_,
                step_residual_,
                mmax,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start_).count()};
+               seconds_since(step_start_)};
   stent_measures(r, false);
   records_.push_back(r);
   last_written_ = false;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <stdexcept>
 
 #include "angio/geometry/centerline_scene.hpp"
 
@@ -241,12 +242,14 @@ BeamScene beam_scene_from(const Node& root) {
       } else {
         nodes = node_list(*fx, kind, nn);
       }
-      for (int n : nodes) {
-        if (std::string(kind) != "axial" && m.axis.project(m.reference_position(n)).r <= 1e-12)
-          r.fail("nodes off the device axis");
-        if (std::string(kind) == "radial") m.fix_radial_only(n);
-        else if (std::string(kind) == "axial") m.fix_axial(n);
-        else m.fix_circumferential(n);
+      try {
+        for (int n : nodes) {
+          if (std::string(kind) == "radial") m.fix_radial_only(n);
+          else if (std::string(kind) == "axial") m.fix_axial(n);
+          else m.fix_circumferential(n);
+        }
+      } catch (const std::invalid_argument& e) {
+        r.fail(std::string("nodes off the device axis (") + e.what() + ")");
       }
     }
   }

@@ -17,26 +17,22 @@ std::vector<Vec3> points_from(const scene::Node& n) {
 }  // namespace
 
 Centerline centerline_from_scene(const scene::Node& node) {
-  if (node.is_sequence()) {
-    try {
-      return Centerline(points_from(node));
-    } catch (const std::invalid_argument& e) {
-      node.fail(std::string("distinct consecutive points (") + e.what() + ")");
+  if (node.is_map()) {
+    node.check_keys({"file", "points"});
+    if (node.has("file") == node.has("points")) node.fail("exactly one of 'file' or 'points'");
+    if (node.has("file")) {
+      const std::string path = scene::resolve_path(node, node.string("file"));
+      try {
+        return read_centerline(path);
+      } catch (const std::exception& e) {
+        node.child("file").fail(std::string("a readable centerline file with distinct points 'x y z' per line (") +
+                                e.what() + ")");
+      }
     }
+  } else if (!node.is_sequence()) {
+    node.fail("{file: path} or {points: [[x, y, z], ...]}");
   }
-  if (!node.is_map()) node.fail("{file: path} or {points: [[x, y, z], ...]}");
-  node.check_keys({"file", "points"});
-  if (node.has("file") == node.has("points")) node.fail("exactly one of 'file' or 'points'");
-  if (node.has("file")) {
-    const std::string path = scene::resolve_path(node, node.string("file"));
-    try {
-      return read_centerline(path);
-    } catch (const std::exception& e) {
-      node.child("file").fail(std::string("a readable centerline file with distinct points 'x y z' per line (") +
-                              e.what() + ")");
-    }
-  }
-  const scene::Node p = node.child("points");
+  const scene::Node p = node.is_sequence() ? node : node.child("points");
   try {
     return Centerline(points_from(p));
   } catch (const std::invalid_argument& e) {

@@ -37,8 +37,6 @@ Quat triad_from_tangent(const Vec3& t, const Vec3& up);
 // Convected strains (Γ, Ω) of the current configuration.
 Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
                     const Quat& R2);
-// Reference (midpoint) triad Λ_r of the current configuration.
-Quat element_midpoint_triad(const ElementReference& ref, const Quat& R1, const Quat& R2);
 
 struct ElementResult {
   Vec12 residual;  // internal forces and moments (spatial), N and N mm

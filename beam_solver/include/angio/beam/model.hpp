@@ -97,13 +97,14 @@ class BeamModel {
 
   // Supports: `fixed` = {ux,uy,uz,rx,ry,rz} in the node's basis (columns: local directions).
   void fix(int node, const std::array<bool, 6>& fixed);
-  void set_basis(int node, const Mat3& basis);
-  // Only radial motion w.r.t. the axis (circumferential + axial translations fixed).
-  void fix_radial_only(int node);
-  // Only the axial translation fixed (w.r.t. the axis).
-  void fix_axial(int node);
-  // Only the circumferential translation fixed (w.r.t. the axis).
-  void fix_circumferential(int node);
+  // Fixation w.r.t. the axis: the node's translation basis becomes (radial, circumferential,
+  // axial). Radial and circumferential fixation throw std::invalid_argument for a node on the axis.
+  // Only radial motion (circumferential + axial translations fixed).
+  void fix_radial_only(int node) { fix_cylindrical(node, true, true); }
+  // Only the axial translation fixed.
+  void fix_axial(int node) { fix_cylindrical(node, false, true); }
+  // Only the circumferential translation fixed.
+  void fix_circumferential(int node) { fix_cylindrical(node, true, false); }
 
   Axis axis;
   std::vector<NodalLoad> nodal_loads;
@@ -153,8 +154,10 @@ class BeamModel {
   // Nodal forces consistent with sample_contact_loads() (for output), N per node.
   std::vector<Vec3> sample_load_nodal_forces() const;
 
-  // Mean radial distance of the nodes from the axis, times 2.
-  double diameter() const;
+  // Mean radial distance of the nodes from the axis, times 2: of all nodes, or of the given ones
+  // (0 for none), at the current or the reference positions.
+  double diameter(bool reference = false) const;
+  double diameter(const std::vector<int>& nodes, bool reference = false) const;
 
   // ---- state ----
   void set_time(double t);  // evaluates load curves and applies prescribed values
@@ -173,7 +176,10 @@ class BeamModel {
   void apply_increment(const Eigen::VectorXd& d, double alpha = 1.0);
 
  private:
-  Mat12 element_transform(int e) const;
+  void fix_cylindrical(int node, bool circumferential, bool axial);
+  // Element evaluation and assembly into the full 6N residual rg (global basis) and, with K, the
+  // reduced tangent; assemble() and global_residual() reduce / return rg.
+  void assemble_global(SpMat* K, Eigen::VectorXd& rg);
 
   std::vector<Vec3> X_;
   std::vector<std::array<int, 2>> elem_nodes_;
@@ -194,8 +200,13 @@ class BeamModel {
   std::vector<SamplePlane> planes_;
   std::vector<Vec3> ref_radial_;  // reference radial direction per sample point
   std::vector<char> identity_basis_;
+  std::vector<int> elem_dofs_;    // per element its 12 free DOF indices (−1: fixed)
   SpMat pattern_;                 // sparsity pattern of the reduced tangent (built once)
   std::vector<int> elem_pos_;     // per element 144 positions into pattern_ values (−1: fixed)
+  // assembly scratch, reused between calls: element results and per-element distributed loads
+  std::vector<ElementResult> elem_results_;
+  std::vector<Vec3> elem_q_;                           // uniform line load (N/mm)
+  std::vector<double> elem_p_follower_, elem_p_dead_;  // radial line loads (N/mm)
   std::vector<double> gauss_xi_, gauss_w_;
   double time_ = 0;
   std::unique_ptr<LinearSolver> lin_;

@@ -20,7 +20,6 @@ class BeamOutput {
 
   void write_step(const BeamModel& m, int step, double time);
   void close();
-  const std::string& dir() const { return dir_; }
 
  private:
   void write_xdmf() const;

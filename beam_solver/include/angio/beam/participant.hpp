@@ -28,10 +28,6 @@ class BeamSolverParticipant : public participant::BeamParticipant {
 
   BeamModel& model() { return *scene_.model; }
   const std::vector<StepRecord>& records() const { return records_; }
-  // Wall time of all Newton iterations / number of iterations (s), for benchmarks.
-  double seconds_per_iteration() const {
-    return iterations_total_ ? newton_seconds_ / iterations_total_ : 0.0;
-  }
 
  private:
   BeamScene scene_;
