@@ -38,11 +38,13 @@ ContactSpec read_contact_spec(const Node& root) {
     spec.balloon_artery.reset();
     return spec;
   }
-  c->check_keys({"stent_balloon", "stent_artery", "balloon_artery", "search_radius", "line_regularization", "log"});
+  c->check_keys({"stent_balloon", "stent_artery", "balloon_artery", "search_radius", "line_regularization", "line_normals",
+                "log"});
   spec.search_radius = c->positive_or("search_radius", spec.search_radius);
   spec.line_regularization = c->non_negative_or("line_regularization", spec.line_regularization);
   if (!(spec.line_regularization < 0.5 * spec.search_radius))
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
+  spec.line_averaged_normals = c->choice_or("line_normals", {"closest_point", "averaged"}, "closest_point") == "averaged";
   spec.log = c->boolean_or("log", spec.log);
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery);
@@ -70,6 +72,7 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   PenaltyStentContact::Options so;
   so.search_radius = spec.search_radius;
   so.regularization = spec.line_regularization;
+  so.averaged_normals = spec.line_averaged_normals;
   if (has_balloon) so.balloon_penalty = spec.stent_balloon;
   if (has_artery) so.artery_penalty = spec.stent_artery;
   if (so.balloon_penalty || so.artery_penalty) {

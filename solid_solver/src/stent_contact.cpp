@@ -30,7 +30,8 @@ void insert(const SolidModel& model, const std::vector<contact::NodalContributio
     for (size_t a = 0; a < c.nodes.size(); ++a)
       for (int k = 0; k < 3; ++k) idx[3 * a + k] = model.dof(c.nodes[a], k);
     ANGIO_PETSC(VecSetValues(r, m, idx.data(), c.r.data(), ADD_VALUES));
-    // K is symmetric: the same values in row- or column-major order (the model's Mat is column-oriented).
+    // Eigen's column-major K goes in as is: the model's Mat is column-oriented (K is not symmetric with
+    // averaged normals).
     if (K && c.K.rows() == m && c.K.cols() == m) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), c.K.data(), ADD_VALUES));
   }
 }
@@ -86,6 +87,7 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
     if (!s || s->faces.empty()) return;
     surfaces_.push_back(std::make_unique<contact::Surface>(to_contact_surface(*s, +1.0)));
     searches_.push_back(std::make_unique<contact::SurfaceSearch>(*surfaces_.back(), opt_.search_radius));
+    searches_.back()->enable_normal_field(opt_.averaged_normals);
     names_.push_back(name);
     penalty_.push_back(*eps);
   };
@@ -116,6 +118,7 @@ std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const Sol
     contact::LineContactParams par;
     par.penalty = penalty_[k];
     par.regularization = opt_.regularization;
+    par.averaged_normals = opt_.averaged_normals;
     par.compute_tangent = tangent;
     per_surface.push_back(contact::evaluate_line_contact(points, one, par));
   }

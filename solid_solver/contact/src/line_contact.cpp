@@ -1,5 +1,6 @@
 #include "angio/contact/line_contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace angio::contact {
@@ -59,6 +60,82 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
   }
 }
 
+void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX& X, const FaceX& Nn,
+                                const NormalFieldProjection& proj, const LineContactParams& par, PointContact& pc,
+                                Eigen::VectorXd& r, Eigen::MatrixXd* K) {
+  const int nn = num_nodes(kind);
+  pc.proj = Projection{};
+  pc.proj.valid = proj.valid;
+  pc.proj.xi = proj.xi;
+  pc.proj.s = proj.s;
+  pc.proj.n = pc.proj.n_face = proj.nu;
+  pc.proj.d = proj.d;
+  pc.proj.distance = std::abs(proj.d);
+  pc.proj.iterations = proj.iterations;
+  pc.gap = proj.d - bp.R;
+  const double g0 = par.regularization;
+  pc.active = pc.gap < g0;
+  pc.q.setZero();
+  pc.dq_dx.setZero();
+  pc.energy = 0.0;
+  r.setZero(3 * nn);
+  if (K) K->setZero(3 * nn, 6 * nn);
+  if (!pc.active) return;
+  const double w = bp.w;
+  const auto [pi, f, k] = penalty_law(pc.gap, g0, par.penalty);
+  pc.energy = w * pi;
+  pc.q = f * proj.nu;
+  NormalFieldLinearization L;
+  const bool need = K != nullptr || par.beam_tangent;
+  if (need) linearize(kind, X, Nn, proj, L);
+  else shape(kind, proj.xi, L.N);
+  // r_a = w f nu N_a (= minus the force on face node a); f = f(g), df = -k dg
+  for (int a = 0; a < nn; ++a) r.segment<3>(3 * a) = w * f * L.N[a] * proj.nu;
+  if (K) {
+    K->setZero(3 * nn, 6 * nn);
+    const Eigen::MatrixXd dq = -k * proj.nu * L.dd + f * L.dnu;  // d(f nu)/du, 3 x m
+    for (int a = 0; a < nn; ++a) {
+      const Eigen::RowVectorXd dNa = L.dN(a, 0) * L.dxi.row(0) + L.dN(a, 1) * L.dxi.row(1);
+      K->middleRows<3>(3 * a) = w * (L.N[a] * dq + f * proj.nu * dNa).rightCols(6 * nn);
+    }
+  }
+  if (par.beam_tangent) pc.dq_dx = -k * proj.nu * L.dd.head<3>() + f * L.dnu.leftCols<3>();
+}
+
+namespace {
+// Turns the averaged kernel's [face nodes | face nodal normals] contribution into one over the face nodes and
+// the nodes around them: K_ring += K_n,b dn_b/dX_ring (NodeNormal::dn); zero residual rows for ring-only nodes.
+void chain_normals(const Face& face, const SurfaceSearch& S, NodalContribution& nc) {
+  const int nn = face.nn();
+  nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + nn);
+  auto index = [&](int id) {
+    const auto it = std::find(nc.nodes.begin(), nc.nodes.end(), id);
+    if (it != nc.nodes.end()) return int(it - nc.nodes.begin());
+    nc.nodes.push_back(id);
+    return int(nc.nodes.size()) - 1;
+  };
+  for (int b = 0; b < nn; ++b)
+    for (int id : S.node_normal(face.nodes[b]).ring) index(id);
+  const int m = 3 * int(nc.nodes.size());
+  if (nc.K.size() == 0) {
+    nc.r.conservativeResize(m);
+    nc.r.tail(m - 3 * nn).setZero();
+    return;
+  }
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(m, m);
+  K.topLeftCorner(3 * nn, 3 * nn) = nc.K.leftCols(3 * nn);
+  for (int b = 0; b < nn; ++b) {
+    const NodeNormal& nb = S.node_normal(face.nodes[b]);
+    const Eigen::MatrixXd Kn = nc.K.middleCols<3>(3 * nn + 3 * b);
+    for (std::size_t j = 0; j < nb.ring.size(); ++j)
+      K.block(0, 3 * index(nb.ring[j]), 3 * nn, 3) += Kn * nb.dn.middleCols<3>(3 * j);
+  }
+  nc.K = std::move(K);
+  nc.r.conservativeResize(m);
+  nc.r.tail(m - 3 * nn).setZero();
+}
+}  // namespace
+
 LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::span<const SurfaceSearch* const> surfaces,
                                         const LineContactParams& par) {
   LineContactResult res;
@@ -71,15 +148,24 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::
     pcs.assign(points.size(), PointContact{});
     for (std::size_t i = 0; i < points.size(); ++i) {
       const BeamPoint& bp = points[i];
-      const SurfaceProjection sp = S.closest(bp.x, par.projection);
       PointContact& pc = pcs[i];
-      if (!sp.found) continue;
-      pc.found = true;
-      pc.face = sp.face;
-      const Face& face = surf.faces[sp.face];
       NodalContribution nc;
-      line_point_kernel(bp, face.kind, S.face_coords(sp.face), surf.normal_sign, sp.proj, par, pc, nc.r,
-                        par.compute_tangent ? &nc.K : nullptr);
+      Eigen::MatrixXd* K = par.compute_tangent ? &nc.K : nullptr;
+      if (par.averaged_normals) {
+        const SurfaceNormalProjection sp = S.along_normals(bp.x, par.projection.inside_tol);
+        if (!sp.found) continue;
+        pc.face = sp.face;
+        line_point_kernel_averaged(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), S.face_normals(sp.face),
+                                   sp.proj, par, pc, nc.r, K);
+        if (pc.active) chain_normals(surf.faces[sp.face], S, nc);
+      } else {
+        const SurfaceProjection sp = S.closest(bp.x, par.projection);
+        if (!sp.found) continue;
+        pc.face = sp.face;
+        line_point_kernel(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), surf.normal_sign, sp.proj, par, pc, nc.r, K);
+      }
+      pc.found = true;
+      const Face& face = surf.faces[pc.face];
       ++res.diag.num_points;
       res.diag.min_gap = std::min(res.diag.min_gap, pc.gap);
       if (!pc.active) continue;
@@ -89,7 +175,7 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::
       res.diag.force_on_solid -= bp.w * pc.q;
       res.diag.force_magnitude += bp.w * pc.q.norm();
       res.diag.energy += pc.energy;
-      nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + face.nn());
+      if (nc.nodes.empty()) nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + face.nn());
       nc.surface = static_cast<int>(k);
       nc.point = static_cast<int>(i);
       res.solid.push_back(std::move(nc));

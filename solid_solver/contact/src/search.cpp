@@ -119,6 +119,7 @@ void SurfaceSearch::update(std::span<const Vec3> coords, bool rebuild) {
     boxes_[f] = angio::contact::face_box(faces[f].kind, X_[f]);
     boxes_[f].inflate(radius_);
   }
+  if (normal_field_) normals_ = nodal_normals(*surface_, X_, coords.size());
   if (rebuild || !same)
     tree_.build(boxes_);
   else
@@ -186,6 +187,22 @@ SurfaceProjection SurfaceSearch::closest(const Vec3& p, const ProjectionOptions&
   thread_local std::vector<int> cand;
   candidates(p, cand);
   return closest_over(*surface_, X_, boxes_, radius_, cand, p, radius_, opt, reject_free_ ? &free_ : nullptr);
+}
+
+SurfaceNormalProjection SurfaceSearch::along_normals(const Vec3& p, double inside_tol) const {
+  if (!normal_field_) throw std::logic_error("SurfaceSearch: along_normals() needs enable_normal_field()");
+  thread_local std::vector<int> cand;
+  candidates(p, cand);
+  SurfaceNormalProjection best;
+  for (int f : cand) {
+    const NormalFieldProjection pr = project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol);
+    if (pr.valid && std::abs(pr.d) <= radius_ && (best.face < 0 || std::abs(pr.d) < std::abs(best.proj.d))) {
+      best.face = f;
+      best.proj = pr;
+    }
+  }
+  best.found = best.face >= 0;
+  return best;
 }
 
 SurfaceProjection SurfaceSearch::closest_brute_force(const Vec3& p, const ProjectionOptions& opt) const {

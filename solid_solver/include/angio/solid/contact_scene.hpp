@@ -5,6 +5,8 @@
 //     stent_artery: {penalty: 10.0}                # N/mm^2; or `off`
 //     line_regularization: 0.0                     # g0 (mm): 0 = linear penalty law (paper Eq. 4),
 //                                                  # > 0 = C¹ linear-quadratic law (line_contact.hpp)
+//     line_normals: closest_point                  # or averaged: projection along the averaged nodal
+//                                                  # normal field (continuous normal; normal_field.hpp)
 //     balloon_artery: {penalty: 5.0, quadrature: 3, two_pass: false}   # N/mm^3 (README of solid_contact); or `off`
 //     search_radius: 0.3                           # mm (> beam radius + largest penetration)
 //     log: true                                    # one line per converged solid solve (rank 0)
@@ -26,6 +28,7 @@ struct ContactSpec {
   std::optional<PenaltySurfaceContact::Options> balloon_artery = PenaltySurfaceContact::Options{};
   double search_radius = 0.3;
   double line_regularization = 0.0;  // g0, mm (line_contact.hpp LineContactParams::regularization)
+  bool line_averaged_normals = false;  // LineContactParams::averaged_normals
   bool log = true;
 };
 

@@ -57,6 +57,7 @@ class PenaltyStentContact : public StentContact {
     std::optional<double> artery_penalty;   // N/mm^2; unset: no stent-artery contact
     double search_radius = 0.3;             // mm; must exceed R + the largest penetration
     double regularization = 0.0;            // g0 (mm) of the linear-quadratic law (line_contact.hpp)
+    bool averaged_normals = false;          // projection along the averaged normal field (line_contact.hpp)
     std::string balloon_surface = "balloon_outer";
     std::string artery_surface = "artery_inner";
   };

@@ -28,6 +28,12 @@ struct LineContactParams {
   // g = 0 that makes Newton cycle when many points sit at the kink (shift of the contact
   // surface: g0/2 at most).
   double regularization = 0.0;
+  // false: s, n from the closest-point projection (projection.hpp); the normal jumps where the
+  // closest face changes over a concave kink. true: s, n from the projection along the averaged
+  // nodal normal field (normal_field.hpp), continuous over the surface; then
+  //   q = f(g) nu, f_a = -w q N_a(xi), g = d - R, and K is the tangent with the nodal normals held
+  //   fixed (not symmetric).
+  bool averaged_normals = false;
   bool compute_tangent = true;   // fill NodalContribution::K
   bool beam_tangent = false;     // fill PointContact::dq_dx
   ProjectionOptions projection;
@@ -91,6 +97,12 @@ std::vector<RobinPoint> robin_points(const LineContactResult& res, double penalt
 // Returns the contribution on the face nodes (r, K as documented above) and fills pc.gap, pc.q, pc.active.
 void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, double normal_sign, const Projection& proj,
                        const LineContactParams& par, PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K);
+
+// The same for a point projected along the averaged normal field (LineContactParams::averaged_normals);
+// Nn: the face's nodal normals (SurfaceSearch::face_normals).
+void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX& X, const FaceX& Nn,
+                                const NormalFieldProjection& proj, const LineContactParams& par, PointContact& pc,
+                                Eigen::VectorXd& r, Eigen::MatrixXd* K);
 
 // Evaluate all points against all surfaces (searches must be update()d with the current coordinates).
 // The contributions of different surfaces add up (a point may touch balloon and artery at the same time).

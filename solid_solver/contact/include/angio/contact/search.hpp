@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "angio/contact/face.hpp"
+#include "angio/contact/normal_field.hpp"
 #include "angio/contact/projection.hpp"
 
 namespace angio::contact {
@@ -39,6 +40,13 @@ struct SurfaceProjection {
   Projection proj;
 };
 
+// Projection of a point along the averaged normal field (normal_field.hpp).
+struct SurfaceNormalProjection {
+  bool found = false;  // a face with a valid projection and |d| <= radius
+  int face = -1;
+  NormalFieldProjection proj;
+};
+
 class SurfaceSearch {
  public:
   // radius: faces farther than `radius` from a query point are ignored (mm).
@@ -55,12 +63,19 @@ class SurfaceSearch {
   void candidates(const Aabb& b, std::vector<int>& faces) const;
   // Closest point over the candidate faces (ties: lowest face index); found only if distance <= radius.
   SurfaceProjection closest(const Vec3& p, const ProjectionOptions& opt = {}) const;
+  // Projection along the averaged nodal normal field (enable_normal_field()) over the candidate faces: the valid one with the smallest |d|
+  // (ties: lowest face index); found only if |d| <= radius.
+  SurfaceNormalProjection along_normals(const Vec3& p, double inside_tol = 1e-10) const;
   // Same over all faces (reference for tests; ignores the tree but applies the radius).
   SurfaceProjection closest_brute_force(const Vec3& p, const ProjectionOptions& opt = {}) const;
 
   const Surface& surface() const { return *surface_; }
   double radius() const { return radius_; }
   const FaceX& face_coords(int f) const { return X_[f]; }
+  // Averaged nodal normal field (normal_field.hpp), computed by update() once enabled.
+  void enable_normal_field(bool on = true) { normal_field_ = on; }
+  const FaceX& face_normals(int f) const { return normals_.face[f]; }
+  const NodeNormal& node_normal(int id) const { return normals_.node[id]; }
   const Aabb& face_box(int f) const { return boxes_[f]; }  // inflated
   bool ready() const { return ready_; }
   // Bit e (0..3): edge e of face f is free; bit 4 + c: corner c lies on a free edge.
@@ -73,6 +88,8 @@ class SurfaceSearch {
   bool reject_free_ = true;
   std::vector<unsigned> free_;
   std::vector<FaceX> X_;
+  bool normal_field_ = false;
+  NodalNormals normals_;
   std::vector<Aabb> boxes_;
   AabbTree tree_;
 };

@@ -1,0 +1,195 @@
+// Line contact along the averaged nodal normal field (normal_field.hpp, LineContactParams::averaged_normals).
+#include <gtest/gtest.h>
+
+#include "helpers.hpp"
+
+using namespace angio::contact;
+using namespace angio::contact::test;
+
+namespace {
+// Some fixed, non-parallel unit nodal normals for one face (the kernel takes them as inputs).
+FaceX tilted_normals(FaceKind k, const FaceX& X) {
+  FaceX Nn(3, num_nodes(k));
+  const Vec3 c = evaluate(k, X, center_xi(k)).n;
+  for (int a = 0; a < Nn.cols(); ++a) Nn.col(a) = (c + 0.15 * Vec3(std::sin(1.0 + a), std::cos(2.0 * a), 0.3 * a - 0.4)).normalized();
+  return Nn;
+}
+
+// Runs the averaged-normal kernel for a point against one face with fixed nodal normals.
+struct KernelOut {
+  PointContact pc;
+  Eigen::VectorXd r;
+  Eigen::MatrixXd K;
+};
+KernelOut run(FaceKind k, const FaceX& X, const FaceX& Nn, const BeamPoint& bp, const LineContactParams& par,
+              bool tangent) {
+  KernelOut o;
+  const NormalFieldProjection p = project_along_normals(k, X, Nn, bp.x);
+  EXPECT_TRUE(p.valid);
+  line_point_kernel_averaged(bp, k, X, Nn, p, par, o.pc, o.r, tangent ? &o.K : nullptr);
+  return o;
+}
+
+// Consistency: K = dr/d[X, Nn] and dq/dx against central finite differences (nodes and nodal normals as
+// independent inputs, as the kernel documents), and Newton's third law sum_a f_a = -w q.
+void check_kernel(FaceKind k, const FaceX& X, const BeamPoint& bp, double g0) {
+  LineContactParams par;
+  par.penalty = 10.0;
+  par.regularization = g0;
+  par.beam_tangent = true;
+  par.averaged_normals = true;
+  const FaceX Nn = tilted_normals(k, X);
+  const KernelOut o = run(k, X, Nn, bp, par, true);
+  ASSERT_TRUE(o.pc.active);
+  const Eigen::Index nx = X.size();
+  Eigen::VectorXd u(2 * nx);
+  u << flatten(X), flatten(Nn);
+  auto res = [&](const Eigen::VectorXd& v) {
+    return run(k, unflatten(v.head(nx)), unflatten(v.tail(nx)), bp, par, false).r;
+  };
+  EXPECT_LT(rel_diff(o.K, fd_jacobian(res, u, 1e-6)), 1e-6) << name(k);
+  auto qx = [&](const Eigen::VectorXd& v) {
+    BeamPoint b = bp;
+    b.x = v;
+    return Eigen::VectorXd(run(k, X, Nn, b, par, false).pc.q);
+  };
+  EXPECT_LT(rel_diff(o.pc.dq_dx, fd_jacobian(qx, bp.x, 1e-6)), 1e-6) << name(k);
+  Vec3 fsum = Vec3::Zero();
+  for (int a = 0; a < num_nodes(k); ++a) fsum -= o.r.segment<3>(3 * a);
+  EXPECT_LT((fsum + bp.w * o.pc.q).norm(), 1e-13 * (1 + bp.w * o.pc.q.norm()));
+}
+
+// Two flat quad strips meeting at a groove along the y axis (x = 0), faces inclined by +-angle: the surface
+// z = tan(angle) |x|, normals up (+z side).
+test::Mesh groove(double angle) {
+  test::Mesh m = flat_quads(4, 2, 0.1, 0.1, 0.0, -0.2, 0.0);
+  for (Vec3& x : m.x) x.z() = std::tan(angle) * std::abs(x.x());
+  return m;
+}
+}  // namespace
+
+// Compares against: the closest-point projection, which on a flat surface is the same (s, d, normal +z).
+TEST(NormalField, FlatSurfaceEqualsClosestPoint) {
+  test::Mesh m = flat_quads(3, 3, 0.2, 0.25, 0.5);
+  SurfaceSearch S(m.surface, 0.3);
+  S.enable_normal_field();
+  S.update(m.x);
+  for (const Vec3& x : {Vec3(0.13, 0.41, 0.57), Vec3(0.2, 0.25, 0.45), Vec3(0.59, 0.7, 0.6)}) {
+    const SurfaceNormalProjection a = S.along_normals(x);
+    const SurfaceProjection c = S.closest(x);
+    ASSERT_TRUE(a.found && c.found);
+    EXPECT_NEAR(a.proj.d, c.proj.d, 1e-13);
+    EXPECT_LT((a.proj.s - c.proj.s).norm(), 1e-13);
+    EXPECT_LT((a.proj.nu - Vec3::UnitZ()).norm(), 1e-13);
+  }
+}
+
+// Compares against: the exact projection on a cylinder of radius Rc, where the averaged nodal normals are the
+// radial directions at the nodes: along a face's mid-line (nodes at equal angles from it) the field normal is
+// radial, so d = |x_perp| - (chord mid-point distance).
+TEST(NormalField, CylinderMidLineIsRadial) {
+  const double Rc = 1.0;
+  const int nt = 16;
+  test::Mesh m = cylinder(FaceKind::Quad4, Rc, 1.0, nt, 4);
+  SurfaceSearch S(m.surface, 0.3);
+  S.enable_normal_field();
+  S.update(m.x);
+  const double th = 2 * M_PI / nt * 2.5;  // mid-line of face column 2
+  const double r = 1.07;
+  const SurfaceNormalProjection p = S.along_normals(Vec3(r * std::cos(th), r * std::sin(th), 0.3));
+  ASSERT_TRUE(p.found);
+  EXPECT_NEAR(p.proj.d, r - Rc * std::cos(M_PI / nt), 1e-12);
+  EXPECT_LT((p.proj.nu - Vec3(std::cos(th), std::sin(th), 0)).norm(), 1e-12);
+}
+
+// Compares against: central finite differences of the kernel (quad4 warped, tri6 curved, tri3; with the linear
+// and the linear-quadratic penalty law) and the force balance.
+TEST(NormalField, KernelTangentMatchesFiniteDifferences) {
+  const double R = 0.06;
+  const FaceX W = warped_quad();
+  const FaceX T = cylinder_tri6(1.0);
+  for (double g0 : {0.0, 0.01}) {
+    const FacePoint fp = evaluate(FaceKind::Quad4, W, Vec2(0.3, -0.4));
+    check_kernel(FaceKind::Quad4, W, BeamPoint{fp.x + 0.05 * fp.n, 0.3, R}, g0);
+    check_kernel(FaceKind::Quad4, W, BeamPoint{fp.x - 0.02 * fp.n, 0.3, R}, g0);  // centre behind the surface
+    const FacePoint tp = evaluate(FaceKind::Tri6, T, Vec2(0.25, 0.35));
+    check_kernel(FaceKind::Tri6, T, BeamPoint{tp.x + 0.03 * tp.n, 0.1, R}, g0);
+    FaceX T3(3, 3);
+    T3 << 0, 0.3, 0.05, 0, 0.02, 0.25, 0, 0.01, -0.02;
+    const FacePoint t3 = evaluate(FaceKind::Tri3, T3, Vec2(0.3, 0.3));
+    check_kernel(FaceKind::Tri3, T3, BeamPoint{t3.x + 0.02 * t3.n, 0.05, R}, g0);
+  }
+}
+
+// Consistency (continuity): a point moved across a groove (concave kink of 2 x 10 degrees). With the closest-
+// point projection the line load jumps where the closest face changes (the two face normals); along the
+// averaged field it changes by O(step): the largest change between neighbouring positions shrinks with the step.
+TEST(NormalField, LineLoadContinuousAcrossGroove) {
+  const double angle = 10.0 * M_PI / 180.0;
+  test::Mesh m = groove(angle);
+  SurfaceSearch S(m.surface, 0.3);
+  S.enable_normal_field();
+  S.update(m.x);
+  const SurfaceSearch* one[] = {&S};
+  auto max_jump = [&](bool averaged, int n) {
+    LineContactParams par;
+    par.penalty = 10.0;
+    par.averaged_normals = averaged;
+    par.compute_tangent = false;
+    Vec3 last = Vec3::Zero();
+    double jump = 0.0;
+    for (int i = 0; i <= n; ++i) {
+      const BeamPoint bp{Vec3(-0.05 + 0.1 * i / n, 0.1, 0.03), 0.01, 0.06};
+      const LineContactResult res = evaluate_line_contact(std::span<const BeamPoint>(&bp, 1), one, par);
+      EXPECT_EQ(res.diag.num_active, 1);
+      if (i > 0) jump = std::max(jump, (res.q[0] - last).norm());
+      last = res.q[0];
+    }
+    return jump;
+  };
+  const double q_scale = 10.0 * 0.03;  // eps * penetration
+  // closest point: a jump of about 2 sin(angle) q, whatever the step
+  EXPECT_GT(max_jump(false, 200), 0.2 * q_scale);
+  EXPECT_GT(max_jump(false, 400), 0.2 * q_scale);
+  // averaged field: O(step) changes
+  const double j1 = max_jump(true, 200), j2 = max_jump(true, 400);
+  EXPECT_LT(j1, 0.02 * q_scale);
+  EXPECT_NEAR(j2 / j1, 0.5, 0.1);
+}
+
+// Compares against: central finite differences of the globally assembled residual on a perturbed quad cylinder
+// and a curved tri6 patch: every node moved, nodal normals and projections recomputed, so the chain through the
+// normals of the nodes around each face (NodeNormal::dn) is checked with the search and the assembly layout.
+TEST(NormalField, AssembledTangentMatchesFiniteDifferences) {
+  for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
+    test::Mesh m = cylinder(kind, 0.55, 0.6, 10, 3, 0.0, M_PI / 2);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> U(-1, 1);
+    for (Vec3& x : m.x) x += 0.01 * Vec3(U(rng), U(rng), U(rng));
+    const int n = static_cast<int>(m.x.size());
+    std::vector<BeamPoint> pts;
+    for (int i = 0; i < 12; ++i) pts.push_back({cyl(0.59, 0.2 + 0.1 * i, 0.1 + 0.035 * i), 0.03, 0.06});
+    auto assemble = [&](const Eigen::VectorXd& u, Eigen::MatrixXd* K) {
+      std::vector<Vec3> x(n);
+      for (int i = 0; i < n; ++i) x[i] = u.segment<3>(3 * i);
+      SurfaceSearch S(m.surface, 0.3);
+      S.enable_normal_field();
+      S.update(x);
+      const SurfaceSearch* s[] = {&S};
+      LineContactParams par;
+      par.averaged_normals = true;
+      par.regularization = 0.005;
+      par.compute_tangent = K != nullptr;
+      const LineContactResult res = evaluate_line_contact(pts, s, par);
+      EXPECT_EQ(res.diag.num_active, 12);
+      return assemble_dense(res.solid, n, K);
+    };
+    Eigen::VectorXd u(3 * n);
+    for (int i = 0; i < n; ++i) u.segment<3>(3 * i) = m.x[i];
+    Eigen::MatrixXd K;
+    const Eigen::VectorXd r = assemble(u, &K);
+    ASSERT_GT(r.norm(), 0.0);
+    const Eigen::MatrixXd Kfd = fd_jacobian([&](const Eigen::VectorXd& v) { return assemble(v, nullptr); }, u, 1e-6);
+    EXPECT_LT(rel_diff(K, Kfd), 1e-6) << name(kind);
+  }
+}
