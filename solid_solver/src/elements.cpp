@@ -241,12 +241,6 @@ bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixX
   return false;
 }
 
-static Mat3 skew(const Vec3d& a) {
-  Mat3 m;
-  m << 0, -a(2), a(1), a(2), 0, -a(0), -a(1), a(0), 0;
-  return m;
-}
-
 void face_pressure(FaceType t, const Eigen::MatrixXd& x, double p, Eigen::VectorXd& r, Eigen::MatrixXd* K) {
   const int n = num_nodes(t);
   r.setZero(3 * n);
@@ -260,10 +254,8 @@ void face_pressure(FaceType t, const Eigen::MatrixXd& x, double p, Eigen::Vector
     const Vec3d an = g1.cross(g2);
     for (int a = 0; a < n; ++a) r.segment<3>(3 * a) += p * qp.w * N(a) * an;
     if (K) {
-      // d(g1 x g2)/dx_b = dN_b,xi (-skew(g2)) + dN_b,eta skew(g1)
-      const Mat3 s1 = skew(g1), s2 = skew(g2);
       for (int b = 0; b < n; ++b) {
-        const Mat3 dAn = dN(b, 1) * s1 - dN(b, 0) * s2;
+        const Mat3 dAn = contact::d_area_vector(dN(b, 0), dN(b, 1), g1, g2);
         for (int a = 0; a < n; ++a) K->block<3, 3>(3 * a, 3 * b) += p * qp.w * N(a) * dAn;
       }
     }

@@ -21,18 +21,20 @@ void gather_coords(const SolidModel& model, std::vector<contact::Vec3>& coords) 
   for (int i = 0; i < n; ++i) coords[i] = model.position(i);
 }
 
-// Adds contributions (r = dPi/dX, K = d2Pi/dX2, symmetric) with the model's global dof numbers.
+// Adds contributions (r = dPi/dX on the first r.size()/3 nodes, K = dr/dX over all nodes) with the model's global
+// dof numbers. Eigen's column-major K goes in as is: the model's Mat is column-oriented.
 void insert(const SolidModel& model, const std::vector<contact::NodalContribution>& cs, Vec r, Mat K) {
   std::vector<PetscInt> idx;
   for (const auto& c : cs) {
-    const int m = 3 * int(c.nodes.size());
+    const int rows = int(c.r.size()), m = 3 * int(c.nodes.size());
     idx.resize(m);
     for (size_t a = 0; a < c.nodes.size(); ++a)
       for (int k = 0; k < 3; ++k) idx[3 * a + k] = model.dof(c.nodes[a], k);
-    ANGIO_PETSC(VecSetValues(r, m, idx.data(), c.r.data(), ADD_VALUES));
-    // Eigen's column-major K goes in as is: the model's Mat is column-oriented (K is not symmetric with
-    // averaged normals).
-    if (K && c.K.rows() == m && c.K.cols() == m) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), c.K.data(), ADD_VALUES));
+    ANGIO_PETSC(VecSetValues(r, rows, idx.data(), c.r.data(), ADD_VALUES));
+    if (K && c.K.size() > 0) {
+      if (c.K.rows() != rows || c.K.cols() != m) throw std::logic_error("contact contribution: tangent size mismatch");
+      ANGIO_PETSC(MatSetValues(K, rows, idx.data(), m, idx.data(), c.K.data(), ADD_VALUES));
+    }
   }
 }
 

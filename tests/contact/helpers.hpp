@@ -174,7 +174,7 @@ inline Eigen::VectorXd assemble_dense(const std::vector<NodalContribution>& cont
   Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
   if (K) K->setZero(3 * n, 3 * n);
   for (const NodalContribution& c : contributions)
-    for (std::size_t a = 0; a < c.nodes.size(); ++a) {
+    for (Eigen::Index a = 0; a < c.r.size() / 3; ++a) {
       r.segment<3>(3 * c.nodes[a]) += c.r.segment<3>(3 * a);
       if (K)
         for (std::size_t b = 0; b < c.nodes.size(); ++b)

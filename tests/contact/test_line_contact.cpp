@@ -131,7 +131,7 @@ TEST(LineContact, GlobalForceBalanceDistortedCylinder) {
   Vec3 beam = Vec3::Zero(), solid = Vec3::Zero();
   for (std::size_t i = 0; i < pts.size(); ++i) beam += pts[i].w * res.q[i];
   for (const NodalContribution& c : res.solid)
-    for (std::size_t a = 0; a < c.nodes.size(); ++a) solid -= c.r.segment<3>(3 * a);
+    for (Eigen::Index a = 0; a < c.r.size() / 3; ++a) solid -= c.r.segment<3>(3 * a);
   EXPECT_LT((solid + beam).norm(), 1e-13 * beam.norm() + 1e-15);
   EXPECT_LT((res.diag.force_on_solid - solid).norm(), 1e-13 * beam.norm());
   EXPECT_LT(res.diag.min_gap, 0.0);

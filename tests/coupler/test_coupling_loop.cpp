@@ -18,6 +18,22 @@ scene::TimeSettings ramp(int steps) {
   t.min_step = 1e-3;
   return t;
 }
+
+// Runs a ramp of `steps` load steps and returns every accepted step's report (run: the run's totals).
+std::vector<coupler::StepReport> run_ramp(test::SpringBeam& beam, test::WallSolid& wall, int steps,
+                                          const coupler::CouplingSettings& s, coupler::Acceleration& acc,
+                                          coupler::RunReport* run = nullptr) {
+  std::vector<coupler::StepReport> reports;
+  const coupler::RunReport r =
+      coupler::run_coupled(beam, wall, ramp(steps), s, acc, [&](const coupler::StepReport& rep) { reports.push_back(rep); });
+  if (run) *run = r;
+  return reports;
+}
+
+// Analytic fixed point at t = 1 (spring_participants.hpp): q* = eps (s_max − x0 − R) / (1 + eps/kb).
+double analytic_q(const test::SpringBeam& beam, const test::WallSolid& wall) {
+  return wall.eps * (wall.s_max - beam.x0 - beam.R) / (1.0 + wall.eps / beam.kb);
+}
 }  // namespace
 
 TEST(CouplingLoop, ConvergesToAnalyticFixedPointWithAitken) {
@@ -29,12 +45,10 @@ TEST(CouplingLoop, ConvergesToAnalyticFixedPointWithAitken) {
   s.rel_tol = 1e-10;
   s.abs_tol = 1e-12;
   coupler::Aitken aitken(0.5, 1.0);
-  std::vector<coupler::StepReport> reports;
-  auto run = coupler::run_coupled(beam, wall, ramp(4), s, aitken,
-                                  [&](const coupler::StepReport& r) { reports.push_back(r); });
+  coupler::RunReport run;
+  const auto reports = run_ramp(beam, wall, 4, s, aitken, &run);
   ASSERT_EQ(run.steps, 4);
-  // Analytic q* at t = 1 (s = 1.5): eps (s − x0 − R)/(1 + eps/kb).
-  const double q_star = 10.0 * (1.5 - 1.0 - 0.05) / (1.0 + 10.0);
+  const double q_star = analytic_q(beam, wall);
   for (double x : beam.x_committed) EXPECT_NEAR(x, 1.0 + q_star / 1.0, 1e-9);
   EXPECT_NEAR(reports.back().contact.line_loads[0][0], q_star, 1e-9);
   // Step 1 crosses the contact kink (the first iterate overshoots into separation, where the map
@@ -66,9 +80,8 @@ TEST(CouplingLoop, ParticipantFailureCutsTheStep) {
   beam.fail_at_step = 2;
   coupler::CouplingSettings s;
   coupler::Aitken aitken(0.5, 1.0);
-  std::vector<coupler::StepReport> reports;
-  auto run = coupler::run_coupled(beam, wall, ramp(4), s, aitken,
-                                  [&](const coupler::StepReport& r) { reports.push_back(r); });
+  coupler::RunReport run;
+  const auto reports = run_ramp(beam, wall, 4, s, aitken, &run);
   EXPECT_EQ(run.rejected_attempts, 1);
   EXPECT_EQ(beam.rejected, 1);
   EXPECT_EQ(reports[1].cuts, 1);
@@ -99,11 +112,10 @@ TEST(CouplingLoop, RobinSchemeReachesTheSameFixedPointWithExactPlanes) {
   s.rel_tol = 1e-10;
   s.abs_tol = 1e-12;
   coupler::Aitken aitken(0.5, 1.0);
-  std::vector<coupler::StepReport> reports;
-  auto run = coupler::run_coupled(beam, wall, ramp(4), s, aitken,
-                                  [&](const coupler::StepReport& r) { reports.push_back(r); });
+  coupler::RunReport run;
+  const auto reports = run_ramp(beam, wall, 4, s, aitken, &run);
   ASSERT_EQ(run.steps, 4);
-  const double q_star = 10.0 * (1.5 - 1.0 - 0.05) / (1.0 + 10.0);
+  const double q_star = analytic_q(beam, wall);
   for (double x : beam.x_committed) EXPECT_NEAR(x, 1.0 + q_star, 1e-9);
   EXPECT_NEAR(reports.back().contact.line_loads[0][0], q_star, 1e-9);
   // Step 2 starts from step 1's plane: ω_0-relaxed first update, then Aitken's secant step is

@@ -8,10 +8,10 @@
 
 #include <cmath>
 
-#include "angio/common/log.hpp"
 #include "angio/participant/standalone.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
+#include "mpi_test.hpp"
 
 using namespace angio::solid;
 
@@ -23,9 +23,6 @@ TEST(Balloon, FreeInflationPlateauAndLockup) {
   // direct solver: ~8k DOFs, much faster than GMRES/ILU on this thin, stiff shell
   sc.options.petsc_options = "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps";
   sc.options.newton.atol = 1e-8;
-  int rank;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  if (rank != 0) angio::log::set_level(angio::log::Level::error);
   SolidRunner runner(PETSC_COMM_WORLD, sc, "");
   ASSERT_EQ(runner.model().mesh().elements.size(), 1276u);
   const double t0 = MPI_Wtime();
@@ -45,7 +42,7 @@ TEST(Balloon, FreeInflationPlateauAndLockup) {
   };
   const double d0 = h.front().d_mid, d03 = d_at(0.3, true), d05 = d_at(0.5, true), d07 = d_at(0.7, true),
                d10 = d_at(1.0, true), dmax = d_at(1.317, true), dend = h.back().d_mid;
-  if (rank == 0)
+  if (angio_test::world_rank() == 0)
     std::printf("balloon D_mid: p=0 %.3f, 0.3 %.3f, 0.5 %.3f, 0.7 %.3f, 1.0 %.3f, 1.317 %.3f, deflated %.4f mm "
                 "(%zu steps, %.1f s)\n",
                 d0, d03, d05, d07, d10, dmax, dend, h.size() - 1, MPI_Wtime() - t0);

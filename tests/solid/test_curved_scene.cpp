@@ -11,7 +11,6 @@
 
 #include <unistd.h>
 
-#include "angio/common/log.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
 
@@ -44,9 +43,6 @@ std::string scene_error(const std::string& path) {
 // balloon (start = (24.025 − 18)/2), and the reference outer diameter 0.98 mm measured from the
 // curved centerline at all three stations (to round-off: the nodes sit exactly at 0.49 mm).
 TEST(CurvedScene, BalloonOnTheCenterline) {
-  int rank;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  if (rank != 0) angio::log::set_level(angio::log::Level::error);
   SolidScene sc = read_solid_scene(angio::scene::load_scene(kConfigs + "/curved_free_expansion.yaml"));
   EXPECT_EQ(sc.mesh.elements.size(), 2772u);
   ASSERT_EQ(sc.springs.size(), 2u);

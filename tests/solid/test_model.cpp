@@ -12,6 +12,7 @@
 #include "angio/solid/model.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
+#include "mpi_test.hpp"
 
 using namespace angio::solid;
 
@@ -19,17 +20,10 @@ namespace angio_test {
 Mesh cube_mesh(ElemType t, int n, double perturb, unsigned seed);
 }
 
+using angio_test::world_rank;
+using angio_test::world_size;
+
 namespace {
-int world_rank() {
-  int r;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &r);
-  return r;
-}
-int world_size() {
-  int s;
-  MPI_Comm_size(PETSC_COMM_WORLD, &s);
-  return s;
-}
 ModelOptions direct_options() {
   ModelOptions o;
   o.petsc_options = "-ksp_rtol 1e-12";
@@ -284,19 +278,4 @@ TEST(Scene, ErrorsNameTheKey) {
   } catch (const angio::scene::SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("artery.layers.media.E"), std::string::npos) << e.what();
   }
-}
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  int fake_argc = 1;
-  PetscInitialize(&fake_argc, &argv, nullptr, nullptr);
-  if (world_rank() != 0) {
-    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
-    delete listeners.Release(listeners.default_result_printer());
-  }
-  const int rc = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&rc, &any, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
-  PetscFinalize();
-  return any;
 }

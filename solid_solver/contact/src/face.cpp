@@ -106,6 +106,12 @@ FaceX gather(const Face& f, std::span<const Vec3> coords) {
   return X;
 }
 
+Mat3 skew(const Vec3& v) {
+  Mat3 S;
+  S << 0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0;
+  return S;
+}
+
 FacePoint evaluate(FaceKind k, const FaceX& X, const Vec2& xi, double normal_sign) {
   ShapeN N;
   ShapeD dN;

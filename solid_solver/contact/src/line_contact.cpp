@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace angio::contact {
 
@@ -25,24 +26,33 @@ PenaltyLaw penalty_law(double g, double g0, double eps) {
   if (g <= 0.0) return {eps * (0.5 * g * g - 0.5 * g0 * g + g0 * g0 / 6.0), eps * (0.5 * g0 - g), eps};
   return {eps * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0), 0.5 * eps * (g0 - g) * (g0 - g) / g0, eps * (g0 - g) / g0};
 }
+
+// Common start of both point kernels: the gap g = d − R, activity g < g0, everything reset (r: 3 nn,
+// K: 3 nn x k_cols). Returns the penalty law at g if the point is active.
+std::optional<PenaltyLaw> start_point(const BeamPoint& bp, double d, int nn, int k_cols, const LineContactParams& par,
+                                      PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K) {
+  pc.gap = d - bp.R;
+  pc.active = pc.gap < par.regularization;
+  pc.q.setZero();
+  pc.dq_dx.setZero();
+  pc.energy = 0.0;
+  r.setZero(3 * nn);
+  if (K) K->setZero(3 * nn, k_cols);
+  if (!pc.active) return std::nullopt;
+  const PenaltyLaw law = penalty_law(pc.gap, par.regularization, par.penalty);
+  pc.energy = bp.w * law.pi;
+  return law;
+}
 }  // namespace
 
 void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, double normal_sign, const Projection& proj,
                        const LineContactParams& par, PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K) {
   const int nn = num_nodes(kind);
   pc.proj = proj;
-  pc.gap = proj.d - bp.R;
-  const double g0 = par.regularization;
-  pc.active = pc.gap < g0;
-  pc.q.setZero();
-  pc.dq_dx.setZero();
-  pc.energy = 0.0;
-  r.setZero(3 * nn);
-  if (K) K->setZero(3 * nn, 3 * nn);
-  if (!pc.active) return;
+  const auto law = start_point(bp, proj.d, nn, 3 * nn, par, pc, r, K);
+  if (!law) return;
+  const auto [pi, f, k] = *law;
   const double w = bp.w;
-  const auto [pi, f, k] = penalty_law(pc.gap, g0, par.penalty);
-  pc.energy = w * pi;
   pc.q = f * proj.n;
   const bool need_h = K != nullptr || par.beam_tangent;
   GapLinearization L;
@@ -72,27 +82,19 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
   pc.proj.d = proj.d;
   pc.proj.distance = std::abs(proj.d);
   pc.proj.iterations = proj.iterations;
-  pc.gap = proj.d - bp.R;
-  const double g0 = par.regularization;
-  pc.active = pc.gap < g0;
-  pc.q.setZero();
-  pc.dq_dx.setZero();
-  pc.energy = 0.0;
-  r.setZero(3 * nn);
-  if (K) K->setZero(3 * nn, 6 * nn);
-  if (!pc.active) return;
+  const auto law = start_point(bp, proj.d, nn, 6 * nn, par, pc, r, K);
+  if (!law) return;
+  const auto [pi, f, k] = *law;
   const double w = bp.w;
-  const auto [pi, f, k] = penalty_law(pc.gap, g0, par.penalty);
-  pc.energy = w * pi;
   pc.q = f * proj.nu;
   NormalFieldLinearization L;
-  const bool need = K != nullptr || par.beam_tangent;
-  if (need) linearize(kind, X, Nn, proj, L);
-  else shape(kind, proj.xi, L.N);
-  // r_a = w f nu N_a (= minus the force on face node a); f = f(g), df = -k dg
+  if (K || par.beam_tangent)
+    linearize(kind, X, Nn, proj, L);
+  else
+    shape(kind, proj.xi, L.N);
+  // r_a = w f nu N_a (= minus the force on face node a); f = f(g), df = −k dg
   for (int a = 0; a < nn; ++a) r.segment<3>(3 * a) = w * f * L.N[a] * proj.nu;
   if (K) {
-    K->setZero(3 * nn, 6 * nn);
     const Eigen::MatrixXd dq = -k * proj.nu * L.dd + f * L.dnu;  // d(f nu)/du, 3 x m
     for (int a = 0; a < nn; ++a) {
       const Eigen::RowVectorXd dNa = L.dN(a, 0) * L.dxi.row(0) + L.dN(a, 1) * L.dxi.row(1);
@@ -103,8 +105,9 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
 }
 
 namespace {
-// Turns the averaged kernel's [face nodes | face nodal normals] contribution into one over the face nodes and
-// the nodes around them: K_ring += K_n,b dn_b/dX_ring (NodeNormal::dn); zero residual rows for ring-only nodes.
+// Turns the averaged kernel's tangent over [face nodes | face nodal normals] into one over the face nodes
+// followed by the other nodes of their rings: K_ring += K_n,b dn_b/dX_ring (NodeNormal::dn). The residual
+// stays on the face nodes (NodalContribution: rows = the first r.size()/3 nodes).
 void chain_normals(const Face& face, const SurfaceSearch& S, NodalContribution& nc) {
   const int nn = face.nn();
   nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + nn);
@@ -116,23 +119,14 @@ void chain_normals(const Face& face, const SurfaceSearch& S, NodalContribution& 
   };
   for (int b = 0; b < nn; ++b)
     for (int id : S.node_normal(face.nodes[b]).ring) index(id);
-  const int m = 3 * int(nc.nodes.size());
-  if (nc.K.size() == 0) {
-    nc.r.conservativeResize(m);
-    nc.r.tail(m - 3 * nn).setZero();
-    return;
-  }
-  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(m, m);
-  K.topLeftCorner(3 * nn, 3 * nn) = nc.K.leftCols(3 * nn);
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(3 * nn, 3 * Eigen::Index(nc.nodes.size()));
+  K.leftCols(3 * nn) = nc.K.leftCols(3 * nn);
   for (int b = 0; b < nn; ++b) {
     const NodeNormal& nb = S.node_normal(face.nodes[b]);
-    const Eigen::MatrixXd Kn = nc.K.middleCols<3>(3 * nn + 3 * b);
-    for (std::size_t j = 0; j < nb.ring.size(); ++j)
-      K.block(0, 3 * index(nb.ring[j]), 3 * nn, 3) += Kn * nb.dn.middleCols<3>(3 * j);
+    const auto Kn = nc.K.middleCols<3>(3 * nn + 3 * b);
+    for (std::size_t j = 0; j < nb.ring.size(); ++j) K.middleCols<3>(3 * index(nb.ring[j])) += Kn * nb.dn.middleCols<3>(3 * j);
   }
   nc.K = std::move(K);
-  nc.r.conservativeResize(m);
-  nc.r.tail(m - 3 * nn).setZero();
 }
 }  // namespace
 
@@ -157,7 +151,7 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::
         pc.face = sp.face;
         line_point_kernel_averaged(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), S.face_normals(sp.face),
                                    sp.proj, par, pc, nc.r, K);
-        if (pc.active) chain_normals(surf.faces[sp.face], S, nc);
+        if (pc.active && K) chain_normals(surf.faces[sp.face], S, nc);
       } else {
         const SurfaceProjection sp = S.closest(bp.x, par.projection);
         if (!sp.found) continue;

@@ -1,5 +1,6 @@
 #include "angio/contact/normal_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace angio::contact {
@@ -14,25 +15,24 @@ Vec2 node_xi(FaceKind k, int a) {
 }
 }  // namespace
 
-NodalNormals nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes) {
+void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out) {
   // v_a = sum over faces f at a of t_f(a) = c / |c|, c = x_,xi x x_,eta of f at a (times normal_sign);
-  // dc/dX_b = -dN_b,xi [x_,eta]x + dN_b,eta [x_,xi]x,  dt = (I - t t^T) dc / |c|,  n_a = v_a / |v_a|.
-  NodalNormals out;
-  std::vector<Vec3> v(num_nodes, Vec3::Zero());
-  out.node.resize(num_nodes);
-  auto column = [](NodeNormal& nn, int id) {
-    for (std::size_t i = 0; i < nn.ring.size(); ++i)
-      if (nn.ring[i] == id) return int(i);
-    nn.ring.push_back(id);
-    nn.dn.conservativeResize(3, 3 * Eigen::Index(nn.ring.size()));
-    nn.dn.rightCols<3>().setZero();
-    return int(nn.ring.size()) - 1;
-  };
-  auto cross = [](const Vec3& a) {
-    Mat3 A;
-    A << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
-    return A;
-  };
+  // dc/dX_b = d_area_vector (face.hpp), dt = (I - t t^T) dc / |c|, n_a = v_a / |v_a|.
+  if (out.node.size() != num_nodes || out.face.size() != s.faces.size()) {
+    out.node.assign(num_nodes, NodeNormal{});
+    for (const Face& face : s.faces)
+      for (int a = 0; a < face.nn(); ++a) {
+        std::vector<int>& ring = out.node[face.nodes[a]].ring;
+        for (int b = 0; b < face.nn(); ++b)
+          if (std::find(ring.begin(), ring.end(), face.nodes[b]) == ring.end()) ring.push_back(face.nodes[b]);
+      }
+    out.face.assign(s.faces.size(), FaceX());
+    for (std::size_t f = 0; f < s.faces.size(); ++f) out.face[f].resize(3, s.faces[f].nn());
+  }
+  for (NodeNormal& nn : out.node) {
+    nn.n.setZero();  // accumulates v_a first
+    nn.dn.setZero(3, 3 * Eigen::Index(nn.ring.size()));
+  }
   for (std::size_t f = 0; f < s.faces.size(); ++f) {
     const Face& face = s.faces[f];
     for (int a = 0; a < face.nn(); ++a) {
@@ -45,28 +45,22 @@ NodalNormals nodal_normals(const Surface& s, std::span<const FaceX> X, std::size
       const Vec3 t = c / cn;
       const Mat3 P = (Mat3::Identity() - t * t.transpose()) / cn;
       NodeNormal& nn = out.node[face.nodes[a]];
-      if (nn.dn.rows() != 3) nn.dn.resize(3, 0);
-      v[face.nodes[a]] += t;
+      nn.n += t;
       for (int b = 0; b < face.nn(); ++b) {
-        const int col = column(nn, face.nodes[b]);
-        nn.dn.middleCols<3>(3 * col) += P * s.normal_sign * (-dN(b, 0) * cross(a2) + dN(b, 1) * cross(a1));
+        const auto col = std::find(nn.ring.begin(), nn.ring.end(), face.nodes[b]) - nn.ring.begin();
+        nn.dn.middleCols<3>(3 * col) += s.normal_sign * P * d_area_vector(dN(b, 0), dN(b, 1), a1, a2);
       }
     }
   }
-  for (std::size_t id = 0; id < num_nodes; ++id) {
-    NodeNormal& nn = out.node[id];
+  for (NodeNormal& nn : out.node) {
     if (nn.ring.empty()) continue;
-    const double vn = v[id].norm();
-    nn.n = v[id] / vn;
-    nn.dn = (Mat3::Identity() - nn.n * nn.n.transpose()) / vn * nn.dn;
+    const double vn = nn.n.norm();
+    nn.n /= vn;
+    const Mat3 P = (Mat3::Identity() - nn.n * nn.n.transpose()) / vn;
+    for (Eigen::Index j = 0; j < nn.dn.cols(); j += 3) nn.dn.middleCols<3>(j) = (P * nn.dn.middleCols<3>(j)).eval();
   }
-  out.face.resize(s.faces.size());
-  for (std::size_t f = 0; f < s.faces.size(); ++f) {
-    const Face& face = s.faces[f];
-    out.face[f].resize(3, face.nn());
-    for (int a = 0; a < face.nn(); ++a) out.face[f].col(a) = out.node[face.nodes[a]].n;
-  }
-  return out;
+  for (std::size_t f = 0; f < s.faces.size(); ++f)
+    for (int a = 0; a < s.faces[f].nn(); ++a) out.face[f].col(a) = out.node[s.faces[f].nodes[a]].n;
 }
 
 NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const FaceX& Nn, const Vec3& x,
@@ -87,7 +81,7 @@ NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const Fa
     J.col(1) = X * dN.col(1) + alpha * (Nn * dN.col(1));
     J.col(2) = m;
     const Eigen::PartialPivLU<Mat3> lu(J);
-    if (!(std::abs(J.determinant()) > 1e-300)) return p;
+    if (!(std::abs(lu.determinant()) > 1e-300)) return p;
     const Vec3 dy = -lu.solve(F);
     xi += dy.head<2>();
     alpha += dy[2];

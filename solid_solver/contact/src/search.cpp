@@ -5,6 +5,7 @@
 #include <map>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
 
 namespace angio::contact {
 
@@ -119,7 +120,7 @@ void SurfaceSearch::update(std::span<const Vec3> coords, bool rebuild) {
     boxes_[f] = angio::contact::face_box(faces[f].kind, X_[f]);
     boxes_[f].inflate(radius_);
   }
-  if (normal_field_) normals_ = nodal_normals(*surface_, X_, coords.size());
+  if (normal_field_) nodal_normals(*surface_, X_, coords.size(), normals_);
   if (rebuild || !same)
     tree_.build(boxes_);
   else
@@ -148,11 +149,13 @@ double box_dist2(const Aabb& b, const Vec3& p) {
   return d.squaredNorm();
 }
 
-// Closest point over `faces`: faces are visited by increasing distance to their (uninflated) box, and a face is
-// skipped when that lower bound exceeds the best distance found so far (exact pruning). Ties: lowest face index.
-SurfaceProjection closest_over(const Surface& s, const std::vector<FaceX>& X, const std::vector<Aabb>& boxes,
-                               double inflation, std::vector<int>& faces, const Vec3& p, double radius,
-                               const ProjectionOptions& opt, const std::vector<unsigned>* free) {
+// Best projection over `faces`: project(f, proj) projects onto face f and returns the distance |p - s| (infinity to
+// reject the face). Faces are visited by increasing distance from p to their (uninflated) boxes, and the visit stops
+// once that lower bound exceeds the best distance so far (exact pruning: s lies in its face's box). Ties: lowest
+// face index. Returns the best face (-1 if none), its projection and distance.
+template <class Proj, class Project>
+std::tuple<int, Proj, double> nearest_first(const std::vector<Aabb>& boxes, double inflation, const std::vector<int>& faces,
+                                            const Vec3& p, Project project) {
   thread_local std::vector<std::pair<double, int>> order;
   order.clear();
   for (int f : faces) {
@@ -161,24 +164,41 @@ SurfaceProjection closest_over(const Surface& s, const std::vector<FaceX>& X, co
     order.emplace_back(box_dist2(b, p), f);
   }
   std::sort(order.begin(), order.end());
-  SurfaceProjection best;
+  int best = -1;
+  Proj best_proj{}, pr{};
   double dmin = std::numeric_limits<double>::infinity();
   for (const auto& [lb2, f] : order) {
     if (std::sqrt(lb2) > dmin * (1.0 + 1e-12) + 1e-300) break;
-    const Projection pr = project(s.faces[f].kind, X[f], s.normal_sign, p, opt);
-    if (!pr.valid) continue;
-    if (free && pr.location != Location::Interior && pr.d < 0.0) {
-      const unsigned bit = pr.location == Location::Edge ? 1u << pr.index : 1u << (4 + pr.index);
-      if ((*free)[f] & bit) continue;
-    }
-    if (pr.distance < dmin || (pr.distance == dmin && f < best.face)) {
-      dmin = pr.distance;
-      best.face = f;
-      best.proj = pr;
+    const double d = project(f, pr);
+    if (d < dmin || (d == dmin && d < std::numeric_limits<double>::infinity() && f < best)) {
+      dmin = d;
+      best = f;
+      best_proj = pr;
     }
   }
-  best.found = best.face >= 0 && dmin <= radius;
-  if (!best.found) best.face = -1;
+  return {best, best_proj, dmin};
+}
+
+// Closest point over `faces`.
+SurfaceProjection closest_over(const Surface& s, const std::vector<FaceX>& X, const std::vector<Aabb>& boxes,
+                               double inflation, std::vector<int>& faces, const Vec3& p, double radius,
+                               const ProjectionOptions& opt, const std::vector<unsigned>* free) {
+  constexpr double reject = std::numeric_limits<double>::infinity();
+  const auto [f, pr, d] = nearest_first<Projection>(boxes, inflation, faces, p, [&](int f, Projection& pr) {
+    pr = project(s.faces[f].kind, X[f], s.normal_sign, p, opt);
+    if (!pr.valid) return reject;
+    if (free && pr.location != Location::Interior && pr.d < 0.0) {
+      const unsigned bit = pr.location == Location::Edge ? 1u << pr.index : 1u << (4 + pr.index);
+      if ((*free)[f] & bit) return reject;
+    }
+    return pr.distance;
+  });
+  SurfaceProjection best;
+  best.found = f >= 0 && d <= radius;
+  if (best.found) {
+    best.face = f;
+    best.proj = pr;
+  }
   return best;
 }
 }  // namespace
@@ -193,15 +213,18 @@ SurfaceNormalProjection SurfaceSearch::along_normals(const Vec3& p, double insid
   if (!normal_field_) throw std::logic_error("SurfaceSearch: along_normals() needs enable_normal_field()");
   thread_local std::vector<int> cand;
   candidates(p, cand);
+  // |d| = |p - s|: the pruning of the closest point applies unchanged
+  const auto [f, pr, d] =
+      nearest_first<NormalFieldProjection>(boxes_, radius_, cand, p, [&](int f, NormalFieldProjection& pr) {
+        pr = project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol);
+        return pr.valid ? std::abs(pr.d) : std::numeric_limits<double>::infinity();
+      });
   SurfaceNormalProjection best;
-  for (int f : cand) {
-    const NormalFieldProjection pr = project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol);
-    if (pr.valid && std::abs(pr.d) <= radius_ && (best.face < 0 || std::abs(pr.d) < std::abs(best.proj.d))) {
-      best.face = f;
-      best.proj = pr;
-    }
+  best.found = f >= 0 && d <= radius_;
+  if (best.found) {
+    best.face = f;
+    best.proj = pr;
   }
-  best.found = best.face >= 0;
   return best;
 }
 

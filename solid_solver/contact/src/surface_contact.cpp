@@ -4,14 +4,6 @@
 
 namespace angio::contact {
 
-namespace {
-Mat3 skew(const Vec3& v) {
-  Mat3 S;
-  S << 0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0;
-  return S;
-}
-}  // namespace
-
 double surface_gp_kernel(FaceKind sk, const FaceX& Xs, const Vec2& xi_g, double w_g, FaceKind mk, const FaceX& Xm,
                          double master_sign, const Projection& proj, double eps, Eigen::VectorXd& r,
                          Eigen::MatrixXd* K) {
@@ -44,7 +36,7 @@ double surface_gp_kernel(FaceKind sk, const FaceX& Xs, const Vec2& xi_g, double 
   Eigen::MatrixXd Dn(3, ms);  // d(a1 x a2)/dX_s
   for (int a = 0; a < ns; ++a) {
     dW.segment<3>(3 * a) = w_g * (-dNs(a, 0) * nu.cross(a2) + dNs(a, 1) * nu.cross(a1)).transpose();
-    Dn.block<3, 3>(0, 3 * a) = -dNs(a, 0) * skew(a2) + dNs(a, 1) * skew(a1);
+    Dn.block<3, 3>(0, 3 * a) = d_area_vector(dNs(a, 0), dNs(a, 1), a1, a2);
   }
   // Pi = W eps/2 g^2
   r = (0.5 * eps * g * g) * dW.transpose() + (W * eps * g) * dg.transpose();

@@ -73,6 +73,15 @@ struct FacePoint {
 };
 FacePoint evaluate(FaceKind k, const FaceX& X, const Vec2& xi, double normal_sign = 1.0);
 
+// [v]x: the matrix of v x (.)
+Mat3 skew(const Vec3& v);
+// Derivative of the area vector x_,xi x x_,eta with respect to the face node b, whose shape function has the
+// derivatives dN_xi, dN_eta at the point (tangents a1 = x_,xi, a2 = x_,eta there):
+//   d(a1 x a2)/dX_b = dN_eta [a1]x - dN_xi [a2]x
+inline Mat3 d_area_vector(double dN_xi, double dN_eta, const Vec3& a1, const Vec3& a2) {
+  return dN_eta * skew(a1) - dN_xi * skew(a2);
+}
+
 // Quadrature on the parameter domain (weights sum to 4 on quad, 1/2 on triangle).
 // degree: polynomial degree integrated exactly. quad: n x n Gauss points, n = clamp((degree+2)/2, 1, 4);
 // triangle: degree <= 1 -> 1 point, 2 -> 3 points, >= 3 -> 6 points (exact to degree 4).

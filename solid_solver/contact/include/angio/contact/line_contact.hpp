@@ -42,8 +42,11 @@ struct LineContactParams {
 // Nodal residual/tangent contribution of one contact point (or Gauss point) to the solid.
 struct NodalContribution {
   std::vector<int> nodes;   // node ids (as in the faces), 3 dofs each, dof = 3*local + component
-  Eigen::VectorXd r;        // dPi/dX  (= minus the contact forces on these nodes), size 3*nodes
-  Eigen::MatrixXd K;        // d2Pi/dX2 = dr/dX (symmetric), empty if no tangent requested
+  // dPi/dX (= minus the contact forces) on the first r.size()/3 nodes; the nodes after them only enter the
+  // tangent's columns (averaged normals: the ring around the face).
+  Eigen::VectorXd r;
+  Eigen::MatrixXd K;        // dr/dX (r.size() x 3 nodes; symmetric for the closest-point and surface contact),
+                            // empty if no tangent requested
   int surface = -1;         // line contact: index of the surface; surface contact: pass (0, or 1 if two_pass)
   int point = -1;           // line contact: beam point index; surface contact: index into SurfaceContactResult::points
 };
@@ -99,7 +102,8 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
                        const LineContactParams& par, PointContact& pc, Eigen::VectorXd& r, Eigen::MatrixXd* K);
 
 // The same for a point projected along the averaged normal field (LineContactParams::averaged_normals);
-// Nn: the face's nodal normals (SurfaceSearch::face_normals).
+// Nn: the face's nodal normals (SurfaceSearch::face_normals). K = dr/d[X_0..X_{nn-1}, n_0..n_{nn-1}]
+// (3 nn x 6 nn); evaluate_line_contact chains the normal columns to the nodes around the face.
 void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX& X, const FaceX& Nn,
                                 const NormalFieldProjection& proj, const LineContactParams& par, PointContact& pc,
                                 Eigen::VectorXd& r, Eigen::MatrixXd* K);

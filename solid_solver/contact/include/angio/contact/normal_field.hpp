@@ -34,7 +34,9 @@ struct NodalNormals {
   std::vector<NodeNormal> node;
   std::vector<FaceX> face;
 };
-NodalNormals nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes);
+// `out` keeps its rings and storage between calls on the same surface (one call per Newton iteration):
+// the first call builds them, later calls only recompute the values.
+void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out);
 
 struct NormalFieldProjection {
   bool valid = false;      // Newton converged and xi lies in the face (tolerance `inside_tol`)
