@@ -19,9 +19,11 @@ try:  # plots are optional: without matplotlib the table and results.json are st
 except ImportError:
     plt = None
 
-# Paper values (DESIGN §4) for the straight free expansion, shown next to ours.
+# Paper values (DESIGN §4) for the straight free expansion, shown next to ours. The paper's
+# dogboning (§3.1, Fig. 5) is the balloon's: distal vs central radius, largest at 10.4 atm.
 PAPER = {"diameter_initial": 1.15, "diameter_max": 2.59, "diameter_final": 2.31,
-         "recoil": 0.28, "recoil_percent": 10.8, "dogboning_percent": 20.4}
+         "recoil": 0.28, "recoil_percent": 10.8, "dogboning_percent": 20.4, "dogboning_atm": 10.4}
+ATM = 0.101325  # MPa
 
 
 def load_json(p):
@@ -58,6 +60,9 @@ def main(run_dir):
         with open(run / "coupling.csv") as f:
             steps_csv = list(csv.DictReader(f))
 
+    # pressure (atm) at a pseudo-time, from the coupler's per-step CSV
+    p_of_t = {round(float(r["time"]), 9): float(r["pressure"]) / ATM for r in steps_csv}
+
     if beam:
         d = beam["diameter"]
         out["stent"] = d
@@ -69,8 +74,9 @@ def main(run_dir):
         st = beam.get("stent")
         if st:
             out["stent"].update(st)
-            rows += [("dogboning max (%)", st["dogboning_max_percent"], PAPER["dogboning_percent"]),
+            rows += [("stent dogboning max (%)", st["dogboning_max_percent"], None),
                      ("  at time (s)", st["time_of_dogboning_max"], None),
+                     ("  at pressure (atm)", p_of_t.get(round(st["time_of_dogboning_max"], 9), "-"), None),
                      ("foreshortening at max diameter (%)", st["foreshortening_at_max_diameter_percent"], None),
                      ("foreshortening final (%)", st["foreshortening_final_percent"], None)]
     if solid:
@@ -78,6 +84,15 @@ def main(run_dir):
         for k, v in solid.items():
             if isinstance(v, (int, float)) and not isinstance(v, bool):
                 rows.append((f"solid {k}", v, None))
+        dog = [(s["balloon_outer_diameter"]["dogboning"], s) for s in solid.get("steps", [])
+               if "balloon_outer_diameter" in s]
+        if dog:
+            top, at = max(dog, key=lambda x: x[0])
+            press = [v for k, v in at.items() if k.endswith("pressure")]
+            out["solid"]["balloon_dogboning_max_percent"] = 100 * top
+            out["solid"]["time_of_balloon_dogboning_max"] = at["time"]
+            rows += [("balloon dogboning max (%)", 100 * top, PAPER["dogboning_percent"]),
+                     ("  at pressure (atm)", press[0] / ATM if press else "-", PAPER["dogboning_atm"])]
     if coupling:
         out["coupling"] = coupling
         rows += [("load steps", coupling["steps"], None),
@@ -100,8 +115,7 @@ def main(run_dir):
         D = [beam["diameter"]["initial"]] + [s["diameter"] for s in beam["steps"]]
         plot(run / "diameter_vs_time.png", t, D, "pseudo-time t (s)", "stent diameter (mm)")
         if steps_csv:
-            p_of_t = {round(float(r["time"]), 9): float(r["pressure"]) for r in steps_csv}
-            pts = [(p_of_t[round(s["time"], 9)] / 0.101325, s["diameter"]) for s in beam["steps"]
+            pts = [(p_of_t[round(s["time"], 9)], s["diameter"]) for s in beam["steps"]
                    if round(s["time"], 9) in p_of_t]
             if pts:
                 plot(run / "diameter_vs_pressure.png", [p for p, _ in pts], [d for _, d in pts],

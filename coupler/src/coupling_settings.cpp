@@ -19,10 +19,11 @@ CouplingSettings coupling_settings(const scene::Node& root) {
     c->child("max_relaxation").fail("a value >= coupling.initial_relaxation");
   if (auto iqn = c->optional("iqn")) {
     if (s.acceleration != "iqn-ils") iqn->fail("no iqn section (it applies only with coupling.acceleration: iqn-ils)");
-    iqn->check_keys({"reused_steps", "max_columns", "filter"});
+    iqn->check_keys({"reused_steps", "max_columns", "filter", "stagnation"});
     s.iqn.reused_steps = static_cast<int>(iqn->integer_or("reused_steps", s.iqn.reused_steps, 0));
     s.iqn.max_columns = static_cast<int>(iqn->integer_or("max_columns", s.iqn.max_columns, 1));
     if (iqn->has("filter")) s.iqn.filter = iqn->in_range("filter", 1e-14, 0.99);
+    if (iqn->has("stagnation")) s.iqn.stagnation = iqn->in_range("stagnation", 0.0, 0.99);
   }
   s.iqn.initial_relaxation = s.initial_relaxation;
   s.max_iterations = static_cast<int>(c->integer_or("max_iterations", s.max_iterations, 1));

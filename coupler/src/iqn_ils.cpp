@@ -8,6 +8,8 @@ IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) {
   if (!(o_.initial_relaxation > 0.0)) throw std::invalid_argument("IQN-ILS: initial relaxation must be > 0");
   if (o_.reused_steps < 0 || o_.max_columns < 1 || !(o_.filter > 0.0 && o_.filter < 1.0))
     throw std::invalid_argument("IQN-ILS: need reused_steps >= 0, max_columns >= 1, 0 < filter < 1");
+  if (!(o_.stagnation >= 0.0 && o_.stagnation < 1.0))
+    throw std::invalid_argument("IQN-ILS: need 0 <= stagnation < 1");
 }
 
 void IqnIls::begin_step() {
@@ -71,6 +73,19 @@ Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   Eigen::VectorXd next = qt;
   for (int i = 0; i < m; ++i) next += alpha[i] * *ws[kept[i]];
   factor_ = 1.0;
+  // A model step far shorter than the residual means the model claims |1 − λ| > 1/stagnation for
+  // the Jacobian eigenvalue λ along r: a column pair that does not belong to this map (a column
+  // from before a contact switch, or a difference of r at an unchanged q). Repeating it would
+  // return the same iterate forever (the next difference is zero and adds no column), so the
+  // model is dropped and the iteration restarts with the initial relaxation.
+  if ((next - q).norm() < o_.stagnation * r.norm()) {
+    current_ = Columns{};
+    previous_.clear();
+    ++restarts_;
+    last_columns_ = 0;
+    factor_ = o_.initial_relaxation;
+    return q + factor_ * r;
+  }
   return next;
 }
 

@@ -5,6 +5,7 @@
 
 #include "angio/participant/plane_penalty.hpp"
 #include "interface_vectors.hpp"
+#include "angio/common/log.hpp"
 
 namespace angio::coupler {
 
@@ -75,7 +76,9 @@ void Robin::next_iterate(Acceleration& acc, int k) {
     const Eigen::Vector3d n = p_tilde_.n.segment<3>(3 * i);
     r.segment<3>(3 * i) = n.dot(p_tilde_.s.segment<3>(3 * i) - p_.s.segment<3>(3 * i)) * n;
   }
+  const Eigen::VectorXd s_old = p_.s;
   p_.s = acc.update(p_.s, r, k);
+  LOG_DEBUG("robin: plane residual " << r.norm() << ", update " << (p_.s - s_old).norm());
   p_.n = p_tilde_.n;
   p_.eps = p_tilde_.eps;
   p_.g0 = p_tilde_.g0;

@@ -112,3 +112,26 @@ TEST(IqnIls, DependentColumnsAreFilteredWithoutBreakdown) {
   }
   EXPECT_NEAR(q[0], b / (1.0 - a), 1e-12);
 }
+
+TEST(IqnIls, VanishingModelStepRestartsWithRelaxation) {
+  // Consistency property of the safeguard. The caller moved q back to 0 outside the acceleration
+  // (as the robin scheme does for points that just got a plane), so the column pair says that r
+  // changes by (1, 0) while q~ changes by the same amount: the model step q~ + W α is exactly the
+  // current q, and without the safeguard every later update would return it unchanged.
+  IqnIls acc(IqnIlsOptions{0.5, 8, 100, 1e-2});
+  acc.begin_step();
+  Eigen::VectorXd q = acc.update(Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(1.0, 0.0), 0);
+  EXPECT_TRUE(q.isApprox(Eigen::Vector2d(0.5, 0.0)));
+  const Eigen::Vector2d r(2.0, 0.0);
+  q = acc.update(Eigen::Vector2d(0.0, 0.0), r, 1);
+  EXPECT_EQ(acc.restarts(), 1);
+  EXPECT_EQ(acc.last_columns(), 0);
+  EXPECT_DOUBLE_EQ(acc.last_factor(), 0.5);
+  EXPECT_TRUE(q.isApprox(0.5 * r)) << q.transpose();
+  // After the restart the model learns from genuine differences again: with q~ = (2 + q₀/2, q₁/2)
+  // (r = (2, 0) at q = 0 as above, fixed point (4, 0)) one secant step is exact in 1D.
+  const Eigen::Vector2d r2(2.0 + 0.5 * q[0] - q[0], 0.5 * q[1] - q[1]);
+  q = acc.update(q, r2, 2);
+  EXPECT_EQ(acc.restarts(), 1);
+  EXPECT_TRUE(q.isApprox(Eigen::Vector2d(4.0, 0.0))) << q.transpose();
+}

@@ -4,7 +4,7 @@
 //     acceleration: aitken        # aitken | iqn-ils | constant
 //     initial_relaxation: 0.5     # ω_0
 //     max_relaxation: 1.0         # cap on |ω| (aitken)
-//     iqn: {reused_steps: 8, max_columns: 100, filter: 1.0e-2}   # iqn-ils model (iqn_ils.hpp)
+//     iqn: {reused_steps: 8, max_columns: 100, filter: 1.0e-2, stagnation: 1.0e-3}   # iqn-ils model (iqn_ils.hpp)
 //     max_iterations: 50
 //     rel_tol: 1.0e-4             # ||r|| <= rel_tol·||q~|| + abs_tol·sqrt(len)
 //     abs_tol: 1.0e-6             # N/mm

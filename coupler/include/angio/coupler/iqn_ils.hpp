@@ -9,7 +9,10 @@
 // interface modes (here: short-wave strut indentations of the balloon) and relaxes only them.
 // Columns that are nearly linearly dependent are dropped while the QR factorization is built
 // (filter: a column is kept if the part orthogonal to the kept ones exceeds `filter` times its
-// norm; the "QR2" filter of Haelterman et al. 2016).
+// norm; the "QR2" filter of Haelterman et al. 2016). A model whose step is shorter than
+// `stagnation` times the residual is discarded (all columns) and the update relaxes with ω_0:
+// otherwise the same iterate comes back unchanged forever (seen at the first contact of the
+// curved free expansion, where a column from before the contact made r + W α = 0).
 #pragma once
 
 #include <deque>
@@ -24,6 +27,7 @@ struct IqnIlsOptions {
   int reused_steps = 8;             // accepted steps whose columns stay in the model
   int max_columns = 100;            // all columns together (newest kept)
   double filter = 1e-2;             // QR2 filter threshold
+  double stagnation = 1e-3;         // restart when ||q_{k+1} − q_k|| < stagnation ||r_k||
 };
 
 class IqnIls : public Acceleration {
@@ -36,6 +40,8 @@ class IqnIls : public Acceleration {
   std::string name() const override { return "iqn-ils"; }
   // Columns used in the last update (after filtering), for logs and tests.
   int last_columns() const { return last_columns_; }
+  // Restarts of the model after a vanishing step, since construction.
+  int restarts() const { return restarts_; }
 
  private:
   struct Columns {
@@ -47,6 +53,7 @@ class IqnIls : public Acceleration {
   Eigen::VectorXd r_prev_, qt_prev_;
   double factor_;
   int last_columns_ = 0;
+  int restarts_ = 0;
 };
 
 }  // namespace angio::coupler
