@@ -79,6 +79,14 @@ def main(run_dir):
                      ("  at pressure (atm)", p_of_t.get(round(st["time_of_dogboning_max"], 9), "-"), None),
                      ("foreshortening at max diameter (%)", st["foreshortening_at_max_diameter_percent"], None),
                      ("foreshortening final (%)", st["foreshortening_final_percent"], None)]
+            if st.get("axis_radius_initial") is not None:  # curved device: straightening (paper §3.2)
+                rows += [("axis sagitta crimped / max / final (mm)",
+                          " / ".join(f"{st[k]:.3f}" for k in ("axis_sagitta_initial", "axis_sagitta_at_max_diameter",
+                                                              "axis_sagitta_final")), None),
+                         ("axis radius crimped / max / final (mm)",
+                          " / ".join(f"{st[k]:.1f}" if st[k] is not None else "inf"
+                                     for k in ("axis_radius_initial", "axis_radius_at_max_diameter",
+                                               "axis_radius_final")), None)]
     if solid:
         out["solid"] = {k: v for k, v in solid.items() if k != "steps"}
         for k, v in solid.items():

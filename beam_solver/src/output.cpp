@@ -188,7 +188,7 @@ void BeamOutput::write_xdmf() const {
 std::string write_summary(const std::string& path, const BeamModel& m,
                           const std::vector<StepRecord>& steps, bool generated_stent,
                           const std::string& status, double newton_seconds,
-                          long newton_iterations, double initial_length) {
+                          long newton_iterations, const StepRecord& initial) {
   std::ostringstream os;
   os << "{\n  \"status\": \"" << status << "\",\n";
   os << "  \"units\": {\"length\": \"mm\", \"force\": \"N\", \"moment\": \"N mm\", \"time\": \"s\"},\n";
@@ -221,6 +221,7 @@ std::string write_summary(const std::string& path, const BeamModel& m,
       return a.diameter < b.diameter;
     });
     const auto& fin = steps.back();
+    const double initial_length = initial.length;
     os << "  \"stent\": {\"length_initial\": " << num(initial_length) << ", \"length_at_max_diameter\": "
        << num(pk.length) << ", \"length_final\": " << num(fin.length)
        << ", \"foreshortening_at_max_diameter_percent\": " << num(100.0 * (initial_length - pk.length) / initial_length)
@@ -230,8 +231,16 @@ std::string write_summary(const std::string& path, const BeamModel& m,
        << ", \"dogboning_at_max_diameter_percent\": "
        << num(100.0 * (pk.distal_diameter - pk.central_diameter) / pk.distal_diameter)
        << ", \"dogboning_max_percent\": " << num(100.0 * dbmax) << ", \"time_of_dogboning_max\": " << num(tdb)
+       << ", \"axis_sagitta_initial\": " << num(initial.axis_sagitta)
+       << ", \"axis_sagitta_at_max_diameter\": " << num(pk.axis_sagitta)
+       << ", \"axis_sagitta_final\": " << num(fin.axis_sagitta)
+       << ", \"axis_radius_initial\": " << num(initial.axis_radius)
+       << ", \"axis_radius_at_max_diameter\": " << num(pk.axis_radius)
+       << ", \"axis_radius_final\": " << num(fin.axis_radius)
        << ", \"definitions\": \"D_distal: outer crowns of the end rings, D_central: crowns of the middle ring(s); "
-          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = axial extent of the nodes\"},\n";
+          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = axial extent of the nodes; "
+          "axis sagitta: distance of the middle crowns' centroid from the chord through the centroids of the end "
+          "rings' outer crowns, axis radius: radius of the circle through the three (null: straight)\"},\n";
   }
   int total_it = 0;
   double total_wall = 0;
@@ -250,7 +259,7 @@ std::string write_summary(const std::string& path, const BeamModel& m,
        << ", \"max_bending_moment\": " << num(s.max_bending_moment);
     if (generated_stent)
       os << ", \"distal_diameter\": " << num(s.distal_diameter) << ", \"central_diameter\": " << num(s.central_diameter)
-         << ", \"length\": " << num(s.length);
+         << ", \"length\": " << num(s.length) << ", \"axis_sagitta\": " << num(s.axis_sagitta);
     os
        << ", \"wall_seconds\": " << num(s.wall_seconds) << "}" << (i + 1 < steps.size() ? "," : "") << "\n";
   }

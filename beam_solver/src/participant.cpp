@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "angio/beam/axis_bow.hpp"
 #include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 
@@ -18,11 +19,7 @@ BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string&
     out_->write_step(*scene_.model, 0, scene_.time.start);  // reference state
   }
   const BeamModel& m = *scene_.model;
-  if (scene_.stent) {
-    StepRecord r0{};
-    stent_measures(r0, true);
-    initial_length_ = r0.length;
-  }
+  if (scene_.stent) stent_measures(initial_, true);
   LOG_INFO("beam model: " << m.num_nodes() << " nodes, " << m.num_elements() << " elements, "
                           << m.num_free_dofs() << " free DOFs, " << m.num_sample_points()
                           << " contact sample points, linear solver " << m.newton.linear_solver
@@ -37,13 +34,24 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   if (!scene_.stent) return;
   r.distal_diameter = m.diameter(scene_.stent->distal_nodes, reference);
   r.central_diameter = m.diameter(scene_.stent->central_nodes, reference);
+  const auto at = [&](int n) { return reference ? m.reference_position(n) : m.position(n); };
   double smin = 1e300, smax = -1e300;
   for (int n = 0; n < m.num_nodes(); ++n) {
-    const double s = m.axis.project(reference ? m.reference_position(n) : m.position(n)).s;
+    const double s = m.axis.project(at(n)).s;
     smin = std::min(smin, s);
     smax = std::max(smax, s);
   }
   r.length = smax - smin;
+  std::vector<Vec3> distal, central;
+  std::vector<double> distal_s;
+  for (int n : scene_.stent->distal_nodes) {
+    distal.push_back(at(n));
+    distal_s.push_back(m.axis.project(distal.back()).s);
+  }
+  for (int n : scene_.stent->central_nodes) central.push_back(at(n));
+  const AxisBow b = stent_axis_bow(distal, distal_s, central);
+  r.axis_sagitta = b.sagitta;
+  r.axis_radius = b.radius;
 }
 
 participant::SamplePoints BeamSolverParticipant::sample_points() const {
@@ -175,7 +183,7 @@ void BeamSolverParticipant::finish() {
     const bool complete = !records_.empty() && records_.back().time >= scene_.time.end - 1e-12;
     write_summary(run_dir_ + "/beam/summary.json", m, records_, scene_.generated_stent,
                   complete ? "completed" : "incomplete", newton_seconds_, iterations_total_,
-                  initial_length_);
+                  initial_);
     LOG_INFO("beam output written to " << run_dir_ << "/beam (beam.xdmf, beam.h5, summary.json)");
   }
 }

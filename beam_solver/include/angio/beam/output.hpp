@@ -47,12 +47,17 @@ struct StepRecord {
   double distal_diameter = std::numeric_limits<double>::quiet_NaN();
   double central_diameter = std::numeric_limits<double>::quiet_NaN();
   double length = std::numeric_limits<double>::quiet_NaN();
+  // bow of the device axis through the centroids of the end rings' outer crowns and of the middle
+  // crowns (axis_bow.hpp)
+  double axis_sagitta = std::numeric_limits<double>::quiet_NaN();
+  double axis_radius = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Writes summary.json; returns the text written.
+// Writes summary.json; returns the text written. `initial`: the stent measures of the reference
+// state (generated stents).
 std::string write_summary(const std::string& path, const BeamModel& m,
                           const std::vector<StepRecord>& steps, bool generated_stent,
                           const std::string& status, double newton_seconds = 0.0,
-                          long newton_iterations = 0, double initial_length = 0.0);
+                          long newton_iterations = 0, const StepRecord& initial = StepRecord{});
 
 }  // namespace angio::beam

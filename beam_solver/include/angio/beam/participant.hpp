@@ -43,7 +43,7 @@ class BeamSolverParticipant : public participant::BeamParticipant {
   long iterations_total_ = 0;
   bool finished_ = false;
   bool last_written_ = true;
-  double initial_length_ = 0;
+  StepRecord initial_{};  // stent measures of the reference state
   void stent_measures(StepRecord& r, bool reference) const;
   participant::SolveStats solve_loads_(const std::vector<participant::Vec3>& line_loads);
 };
