@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "angio/common/log.hpp"
+
 namespace angio::coupler {
 
 IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) {
@@ -79,6 +81,8 @@ Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   // return the same iterate forever (the next difference is zero and adds no column), so the
   // model is dropped and the iteration restarts with the initial relaxation.
   if ((next - q).norm() < o_.stagnation * r.norm()) {
+    LOG_DEBUG("IQN-ILS: model step " << (next - q).norm() << " against residual " << r.norm()
+                                     << ": columns dropped, relaxation " << o_.initial_relaxation);
     current_ = Columns{};
     previous_.clear();
     ++restarts_;

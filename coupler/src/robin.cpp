@@ -3,9 +3,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "angio/common/log.hpp"
 #include "angio/participant/plane_penalty.hpp"
 #include "interface_vectors.hpp"
-#include "angio/common/log.hpp"
 
 namespace angio::coupler {
 
