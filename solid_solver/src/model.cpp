@@ -46,6 +46,7 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
                                            : element_frame(mesh_, int(e), opt_.axis));
   }
   // reference Jacobians must be positive (catches inverted elements of imported meshes early)
+  ref_volume_.assign(mesh_.elements.size(), 0.0);
   {
     Eigen::VectorXd N;
     Eigen::MatrixXd dN, X;
@@ -55,7 +56,9 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
       for (int a = 0; a < el.nn(); ++a) X.row(a) = mesh_.X[el.n[a]].transpose();
       for (const auto& qp : volume_rule(el.type)) {
         shape(el.type, qp.xi, N, dN);
-        if (!((X.transpose() * dN).determinant() > 0.0))
+        const double detJ = (X.transpose() * dN).determinant();
+        ref_volume_[e] += qp.w * detJ;
+        if (!(detJ > 0.0))
           throw std::runtime_error("solid mesh: element " + std::to_string(e) + " (" + name(el.type) + ", block '" +
                                    mesh_.blocks[el.block].name +
                                    "') has a non-positive reference Jacobian (inverted or degenerate)");
@@ -298,6 +301,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     ANGIO_PETSC(VecSetValues(r, m, idx.data(), fe.data(), ADD_VALUES));
     if (K) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
   };
+  const double c_stab = opt_.newton.stabilization;
   for (int e : local_elements_) {
     const auto& el = mesh_.elements[e];
     gather_nodes(el.n.data(), el.nn(), false);
@@ -305,6 +309,14 @@ bool SolidModel::assemble(Vec r, Mat K) {
     if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr)) {
       ok = 0;
       break;
+    }
+    if (c_stab > 0.0) {
+      // artificial damping (NewtonOptions::stabilization): c·V_e/n_e per node of the element
+      const double m = c_stab * ref_volume_[e] / el.nn();
+      for (int i = 0; i < 3 * el.nn(); ++i) {
+        fe[i] += m * (u_[idx[i]] - u_committed_[idx[i]]);
+        if (K) Ke(i, i) += m;
+      }
     }
     add(el.nn());
   }
@@ -423,6 +435,7 @@ SolveReport SolidModel::solve() {
     if (res <= no.atol || (it > 0 && res <= no.rtol * res0)) {
       rep.converged = true;
       rep.message = "converged";
+      if (no.stabilization > 0.0) rep.stabilization_force = stabilization_force_norm_();
       break;
     }
     if (it >= no.max_iterations) {
@@ -496,6 +509,31 @@ SolveReport SolidModel::solve() {
   }
   rep.total_seconds = MPI_Wtime() - t_start;
   return rep;
+}
+
+double SolidModel::stabilization_force_norm_() {
+  // the forces c·V_e/n_e·(u − u_committed) of assemble(), assembled into the scratch vector du_
+  ANGIO_PETSC(VecSet(du_, 0.0));
+  std::vector<PetscInt> idx;
+  std::vector<double> f;
+  for (int e : local_elements_) {
+    const auto& el = mesh_.elements[e];
+    const double m = opt_.newton.stabilization * ref_volume_[e] / el.nn();
+    idx.resize(3 * el.nn());
+    f.resize(3 * el.nn());
+    for (int a = 0; a < el.nn(); ++a)
+      for (int k = 0; k < 3; ++k) {
+        const int i = 3 * a + k;
+        idx[i] = 3 * perm_[el.n[a]] + k;
+        f[i] = m * (u_[idx[i]] - u_committed_[idx[i]]);
+      }
+    ANGIO_PETSC(VecSetValues(du_, PetscInt(idx.size()), idx.data(), f.data(), ADD_VALUES));
+  }
+  ANGIO_PETSC(VecAssemblyBegin(du_));
+  ANGIO_PETSC(VecAssemblyEnd(du_));
+  PetscReal n;
+  ANGIO_PETSC(VecNorm(du_, NORM_2, &n));
+  return double(n);
 }
 
 void SolidModel::commit() { u_committed_ = u_; }

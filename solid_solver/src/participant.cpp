@@ -137,8 +137,9 @@ void SolidRunner::end_step(bool accept) {
     std::ostringstream os;
     os << std::setprecision(4) << "solid step " << committed_ << " t=" << time_;
     for (const auto& [label, p] : h.pressures) os << " " << label << "=" << p << "MPa";
-    os << " newton=" << last_.iterations << " |r|=" << std::scientific << std::setprecision(2) << last_.residual
-       << std::defaultfloat << std::setprecision(4);
+    os << " newton=" << last_.iterations << " |r|=" << std::scientific << std::setprecision(2) << last_.residual;
+    if (last_.stabilization_force > 0.0) os << " |f_stab|=" << last_.stabilization_force;
+    os << std::defaultfloat << std::setprecision(4);
     if (scene_.balloon_diameter) os << " D_mid=" << h.d_mid << " D_ends=" << h.d_end0 << "/" << h.d_end1 << "mm";
     os << " max_p1[";
     for (size_t b = 0; b < h.max_p1.size(); ++b)

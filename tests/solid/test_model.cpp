@@ -101,6 +101,74 @@ TEST(Model, PressureOnCubeAllFaceTypes) {
   }
 }
 
+// Stabilization (NewtonOptions::stabilization) is artificial damping toward the committed state.
+// Consistency: (1) the first stabilized solve stops short of the equilibrium and reports the force
+// it needed; (2) repeated solve + commit at the same load is a proximal-point iteration whose fixed
+// point is the unstabilized equilibrium (the added force vanishes there), so it converges to the
+// solution without stabilization; (3) Newton stays quadratic with the added diagonal (few
+// iterations per solve), which checks the tangent term.
+TEST(Model, StabilizationConvergesToTheEquilibrium) {
+  const double p = 0.05;
+  auto solve_cube = [&](double c, int cycles, std::vector<double>& force, int& max_newton) {
+    Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
+    SurfaceSet right{"right", {}};
+    for (const auto& el : m.elements)
+      for (const auto& lf : local_faces(el.type)) {
+        Face f;
+        f.type = lf.type;
+        bool on = true;
+        for (size_t a = 0; a < lf.nodes.size(); ++a) {
+          f.n[a] = el.n[lf.nodes[a]];
+          on = on && std::abs(m.X[f.n[a]].x() - 1.0) < 1e-12;
+        }
+        if (on) right.faces.push_back(f);
+      }
+    m.surfaces.push_back(right);
+    m.orient_surfaces();
+    ModelOptions o = direct_options();
+    o.newton.stabilization = c;
+    SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {2.0, 0.3}, {}}}, o);
+    for (int k = 0; k < 3; ++k) {
+      std::vector<int> plane;
+      for (size_t n = 0; n < m.X.size(); ++n)
+        if (std::abs(m.X[n](k)) < 1e-12) plane.push_back(int(n));
+      model.add_dirichlet({plane, k, [](const Vec3d&, double) { return 0.0; }});
+    }
+    model.add_pressure({"right", [p](double) { return p; }});
+    model.set_time(1.0);
+    max_newton = 0;
+    for (int i = 0; i < cycles; ++i) {
+      const auto rep = model.solve();
+      EXPECT_TRUE(rep.converged) << rep.message;
+      force.push_back(rep.stabilization_force);
+      max_newton = std::max(max_newton, rep.iterations);
+      model.commit();
+    }
+    std::vector<Vec3d> u;
+    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model.displacement(int(n)));
+    return u;
+  };
+  std::vector<double> f0, f;
+  int it0 = 0, it = 0;
+  const auto u_ref = solve_cube(0.0, 1, f0, it0);
+  const auto u1 = solve_cube(0.5, 1, f, it);
+  double err1 = 0, scale = 0;
+  for (size_t n = 0; n < u_ref.size(); ++n) {
+    err1 = std::max(err1, (u1[n] - u_ref[n]).norm());
+    scale = std::max(scale, u_ref[n].norm());
+  }
+  EXPECT_GT(err1, 0.05 * scale);  // one stabilized solve stops visibly short
+  EXPECT_GT(f[0], 0.0);
+  f.clear();
+  const auto u = solve_cube(0.5, 20, f, it);
+  double err = 0;
+  for (size_t n = 0; n < u_ref.size(); ++n) err = std::max(err, (u[n] - u_ref[n]).norm());
+  EXPECT_LT(err, 1e-8 * scale);
+  EXPECT_LT(f.back(), 1e-6 * f.front());
+  EXPECT_LE(it, it0 + 1);  // quadratic Newton with the stabilization tangent
+  EXPECT_EQ(f0[0], 0.0);   // off by default
+}
+
 // Thick-walled cylinder, plane strain, small internal pressure: compared with Lame's linear-elastic
 // solution u_r(r) = (1+nu)/E [(1-2nu) A r + B/r], A = p a^2/(b^2-a^2), B = p a^2 b^2/(b^2-a^2).
 TEST(Model, ThickCylinderMatchesLame) {

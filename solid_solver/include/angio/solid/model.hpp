@@ -38,6 +38,11 @@ struct NewtonOptions {
   bool line_search = true;   // backtracking on ||r|| (halving, up to max_line_search times)
   int max_line_search = 6;
   bool verbose = false;      // per-iteration log on rank 0
+  // Artificial damping toward the last committed state (as Abaqus' *STATIC, STABILIZE): each node
+  // gets the force c·V_a·(u_a − u_a,committed) with V_a its share of the element volumes, N/mm⁴.
+  // It carries a load step over a limit point or bifurcation of the pressure-controlled balloon,
+  // at the price of an equilibrium error of that size (reported per solve). 0 = off.
+  double stabilization = 0.0;
 };
 
 struct ModelOptions {
@@ -57,6 +62,7 @@ struct SolveReport {
   double assembly_seconds = 0.0;
   double linear_seconds = 0.0;
   double total_seconds = 0.0;
+  double stabilization_force = 0.0;  // norm of the stabilization forces at the end (N)
 };
 
 struct PressureLoad {
@@ -144,6 +150,8 @@ class SolidModel {
   double time_ = 0.0;
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
+  std::vector<double> ref_volume_;        // reference volume per element (stabilization)
+  double stabilization_force_norm_();
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;
