@@ -24,6 +24,23 @@ using angio_test::world_rank;
 using angio_test::world_size;
 
 namespace {
+// The element faces on the cube face x = 1, as surface set "right".
+SurfaceSet faces_at_x1(const Mesh& m) {
+  SurfaceSet right{"right", {}};
+  for (const auto& el : m.elements)
+    for (const auto& lf : local_faces(el.type)) {
+      Face f;
+      f.type = lf.type;
+      bool on = true;
+      for (size_t a = 0; a < lf.nodes.size(); ++a) {
+        f.n[a] = el.n[lf.nodes[a]];
+        on = on && std::abs(m.X[f.n[a]].x() - 1.0) < 1e-12;
+      }
+      if (on) right.faces.push_back(f);
+    }
+  return right;
+}
+
 ModelOptions direct_options() {
   ModelOptions o;
   o.petsc_options = "-ksp_rtol 1e-12";
@@ -67,18 +84,7 @@ TEST(Model, PressureOnCubeAllFaceTypes) {
   const double E = 2.0, nu = 0.3, p = 2e-5;
   for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
     Mesh m = angio_test::cube_mesh(t, 2, 0.08, 9);
-    SurfaceSet right{"right", {}};
-    for (const auto& el : m.elements)
-      for (const auto& lf : local_faces(el.type)) {
-        Face f;
-        f.type = lf.type;
-        bool on = true;
-        for (size_t a = 0; a < lf.nodes.size(); ++a) {
-          f.n[a] = el.n[lf.nodes[a]];
-          on = on && std::abs(m.X[f.n[a]].x() - 1.0) < 1e-12;
-        }
-        if (on) right.faces.push_back(f);
-      }
+    const SurfaceSet right = faces_at_x1(m);
     ASSERT_FALSE(right.faces.empty());
     m.surfaces.push_back(right);
     m.orient_surfaces();
@@ -111,18 +117,7 @@ TEST(Model, StabilizationConvergesToTheEquilibrium) {
   const double p = 0.05;
   auto solve_cube = [&](double c, int cycles, std::vector<double>& force, int& max_newton) {
     Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
-    SurfaceSet right{"right", {}};
-    for (const auto& el : m.elements)
-      for (const auto& lf : local_faces(el.type)) {
-        Face f;
-        f.type = lf.type;
-        bool on = true;
-        for (size_t a = 0; a < lf.nodes.size(); ++a) {
-          f.n[a] = el.n[lf.nodes[a]];
-          on = on && std::abs(m.X[f.n[a]].x() - 1.0) < 1e-12;
-        }
-        if (on) right.faces.push_back(f);
-      }
+    const SurfaceSet right = faces_at_x1(m);
     m.surfaces.push_back(right);
     m.orient_surfaces();
     ModelOptions o = direct_options();
