@@ -35,18 +35,15 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   r.distal_diameter = m.diameter(scene_.stent->distal_nodes, reference);
   r.central_diameter = m.diameter(scene_.stent->central_nodes, reference);
   const auto at = [&](int n) { return reference ? m.reference_position(n) : m.position(n); };
-  double smin = 1e300, smax = -1e300;
-  for (int n = 0; n < m.num_nodes(); ++n) {
-    const double s = m.axis.project(at(n)).s;
-    smin = std::min(smin, s);
-    smax = std::max(smax, s);
-  }
-  r.length = smax - smin;
+  std::vector<double> s(m.num_nodes());  // arc length of each node's foot on the device axis
+  for (int n = 0; n < m.num_nodes(); ++n) s[n] = m.axis.project(at(n)).s;
+  const auto [smin, smax] = std::minmax_element(s.begin(), s.end());
+  r.length = *smax - *smin;
   std::vector<Vec3> distal, central;
   std::vector<double> distal_s;
   for (int n : scene_.stent->distal_nodes) {
     distal.push_back(at(n));
-    distal_s.push_back(m.axis.project(distal.back()).s);
+    distal_s.push_back(s[n]);
   }
   for (int n : scene_.stent->central_nodes) central.push_back(at(n));
   const AxisBow b = stent_axis_bow(distal, distal_s, central);

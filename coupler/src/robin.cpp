@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "angio/common/log.hpp"
 #include "angio/participant/plane_penalty.hpp"
@@ -72,13 +73,15 @@ void Robin::next_iterate(Acceleration& acc, int k) {
   Eigen::VectorXd r = Eigen::VectorXd::Zero(p_.s.size());
   for (Eigen::Index i = 0; i < p_.eps.size(); ++i) {
     if (!(p_tilde_.eps[i] > 0.0)) continue;
+    // (not an evaluation of the map: the secant pair of this iteration is inconsistent for these
+    // points, and IQN-ILS may see a zero model step later; its stagnation restart handles that)
     if (!(p_.eps[i] > 0.0)) p_.s.segment<3>(3 * i) = p_tilde_.s.segment<3>(3 * i);
     const Eigen::Vector3d n = p_tilde_.n.segment<3>(3 * i);
     r.segment<3>(3 * i) = n.dot(p_tilde_.s.segment<3>(3 * i) - p_.s.segment<3>(3 * i)) * n;
   }
-  const Eigen::VectorXd s_old = p_.s;
-  p_.s = acc.update(p_.s, r, k);
-  LOG_DEBUG("robin: plane residual " << r.norm() << ", update " << (p_.s - s_old).norm());
+  Eigen::VectorXd next = acc.update(p_.s, r, k);
+  LOG_DEBUG("robin: plane residual " << r.norm() << ", update " << (next - p_.s).norm());
+  p_.s = std::move(next);
   p_.n = p_tilde_.n;
   p_.eps = p_tilde_.eps;
   p_.g0 = p_tilde_.g0;

@@ -46,7 +46,7 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
                                            : element_frame(mesh_, int(e), opt_.axis));
   }
   // reference Jacobians must be positive (catches inverted elements of imported meshes early)
-  ref_volume_.assign(mesh_.elements.size(), 0.0);
+  std::vector<double> volume(mesh_.elements.size(), 0.0);  // reference volume per element
   {
     Eigen::VectorXd N;
     Eigen::MatrixXd dN, X;
@@ -57,7 +57,7 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
       for (const auto& qp : volume_rule(el.type)) {
         shape(el.type, qp.xi, N, dN);
         const double detJ = (X.transpose() * dN).determinant();
-        ref_volume_[e] += qp.w * detJ;
+        volume[e] += qp.w * detJ;
         if (!(detJ > 0.0))
           throw std::runtime_error("solid mesh: element " + std::to_string(e) + " (" + name(el.type) + ", block '" +
                                    mesh_.blocks[el.block].name +
@@ -67,6 +67,19 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
   }
   partition_();
   setup_petsc_();
+  if (opt_.newton.stabilization > 0.0) {
+    // c·V_a per dof: each owned element adds c·V_e/n_e to its nodes (a lumped "mass" of unit density)
+    ANGIO_PETSC(VecDuplicate(r_, &stab_diag_));
+    ANGIO_PETSC(VecSet(stab_diag_, 0.0));
+    for (int e : local_elements_) {
+      const auto& el = mesh_.elements[e];
+      const double m = opt_.newton.stabilization * volume[e] / el.nn();
+      for (int a = 0; a < el.nn(); ++a)
+        for (int k = 0; k < 3; ++k) ANGIO_PETSC(VecSetValue(stab_diag_, 3 * perm_[el.n[a]] + k, m, ADD_VALUES));
+    }
+    ANGIO_PETSC(VecAssemblyBegin(stab_diag_));
+    ANGIO_PETSC(VecAssemblyEnd(stab_diag_));
+  }
   u_.assign(3 * mesh_.X.size(), 0.0);
   u_committed_ = u_;
 }
@@ -76,6 +89,7 @@ SolidModel::~SolidModel() {
   if (K_) MatDestroy(&K_);
   if (r_) VecDestroy(&r_);
   if (du_) VecDestroy(&du_);
+  if (stab_diag_) VecDestroy(&stab_diag_);
   if (full_) VecDestroy(&full_);
   if (scatter_) VecScatterDestroy(&scatter_);
   if (options_) PetscOptionsDestroy(&options_);
@@ -301,7 +315,6 @@ bool SolidModel::assemble(Vec r, Mat K) {
     ANGIO_PETSC(VecSetValues(r, m, idx.data(), fe.data(), ADD_VALUES));
     if (K) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
   };
-  const double c_stab = opt_.newton.stabilization;
   for (int e : local_elements_) {
     const auto& el = mesh_.elements[e];
     gather_nodes(el.n.data(), el.nn(), false);
@@ -309,14 +322,6 @@ bool SolidModel::assemble(Vec r, Mat K) {
     if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr)) {
       ok = 0;
       break;
-    }
-    if (c_stab > 0.0) {
-      // artificial damping (NewtonOptions::stabilization): c·V_e/n_e per node of the element
-      const double m = c_stab * ref_volume_[e] / el.nn();
-      for (int i = 0; i < 3 * el.nn(); ++i) {
-        fe[i] += m * (u_[idx[i]] - u_committed_[idx[i]]);
-        if (K) Ke(i, i) += m;
-      }
     }
     add(el.nn());
   }
@@ -345,6 +350,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     ANGIO_PETSC(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
     ANGIO_PETSC(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
   }
+  if (stab_diag_) stabilization_(r, K);
   if (!dirichlet_rows_.empty() && apply_bc_) {
     std::vector<PetscScalar> zeros(dirichlet_rows_.size(), 0.0);
     ANGIO_PETSC(VecSetValues(r, PetscInt(zeros.size()), dirichlet_rows_.data(), zeros.data(), INSERT_VALUES));
@@ -435,7 +441,7 @@ SolveReport SolidModel::solve() {
     if (res <= no.atol || (it > 0 && res <= no.rtol * res0)) {
       rep.converged = true;
       rep.message = "converged";
-      if (no.stabilization > 0.0) rep.stabilization_force = stabilization_force_norm_();
+      if (stab_diag_) rep.stabilization_force = stabilization_(nullptr, nullptr);
       break;
     }
     if (it >= no.max_iterations) {
@@ -511,29 +517,25 @@ SolveReport SolidModel::solve() {
   return rep;
 }
 
-double SolidModel::stabilization_force_norm_() {
-  // the forces c·V_e/n_e·(u − u_committed) of assemble(), assembled into the scratch vector du_
-  ANGIO_PETSC(VecSet(du_, 0.0));
-  std::vector<PetscInt> idx;
-  std::vector<double> f;
-  for (int e : local_elements_) {
-    const auto& el = mesh_.elements[e];
-    const double m = opt_.newton.stabilization * ref_volume_[e] / el.nn();
-    idx.resize(3 * el.nn());
-    f.resize(3 * el.nn());
-    for (int a = 0; a < el.nn(); ++a)
-      for (int k = 0; k < 3; ++k) {
-        const int i = 3 * a + k;
-        idx[i] = 3 * perm_[el.n[a]] + k;
-        f[i] = m * (u_[idx[i]] - u_committed_[idx[i]]);
-      }
-    ANGIO_PETSC(VecSetValues(du_, PetscInt(idx.size()), idx.data(), f.data(), ADD_VALUES));
+double SolidModel::stabilization_(Vec r, Mat K) {
+  // f_a = c·V_a·(u_a − u_a,committed) on the owned dofs, added to r (if given); its tangent c·V_a on
+  // the diagonal of K (if given). Returns the global norm of f.
+  const PetscScalar* d;
+  PetscScalar* rr = nullptr;
+  ANGIO_PETSC(VecGetArrayRead(stab_diag_, &d));
+  if (r) ANGIO_PETSC(VecGetArray(r, &rr));
+  double local = 0.0;
+  for (int i = 3 * node_begin_; i < 3 * node_end_; ++i) {
+    const double f = d[i - 3 * node_begin_] * (u_[i] - u_committed_[i]);
+    if (rr) rr[i - 3 * node_begin_] += f;
+    local += f * f;
   }
-  ANGIO_PETSC(VecAssemblyBegin(du_));
-  ANGIO_PETSC(VecAssemblyEnd(du_));
-  PetscReal n;
-  ANGIO_PETSC(VecNorm(du_, NORM_2, &n));
-  return double(n);
+  if (r) ANGIO_PETSC(VecRestoreArray(r, &rr));
+  ANGIO_PETSC(VecRestoreArrayRead(stab_diag_, &d));
+  if (K) ANGIO_PETSC(MatDiagonalSet(K, stab_diag_, ADD_VALUES));
+  double global = 0.0;
+  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  return std::sqrt(global);
 }
 
 void SolidModel::commit() { u_committed_ = u_; }

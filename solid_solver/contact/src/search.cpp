@@ -5,7 +5,6 @@
 #include <map>
 #include <numeric>
 #include <stdexcept>
-#include <tuple>
 
 namespace angio::contact {
 
@@ -152,10 +151,11 @@ double box_dist2(const Aabb& b, const Vec3& p) {
 // Best projection over `faces`: project(f, proj) projects onto face f and returns the distance |p - s| (infinity to
 // reject the face). Faces are visited by increasing distance from p to their (uninflated) boxes, and the visit stops
 // once that lower bound exceeds the best distance so far (exact pruning: s lies in its face's box). Ties: lowest
-// face index. Returns the best face (-1 if none), its projection and distance.
-template <class Proj, class Project>
-std::tuple<int, Proj, double> nearest_first(const std::vector<Aabb>& boxes, double inflation, const std::vector<int>& faces,
-                                            const Vec3& p, Project project) {
+// face index. Result (SurfaceProjection or SurfaceNormalProjection): found if the best distance is within radius.
+template <class Result, class Project>
+Result nearest_first(const std::vector<Aabb>& boxes, double inflation, const std::vector<int>& faces, const Vec3& p,
+                     double radius, Project project) {
+  using Proj = decltype(Result::proj);
   thread_local std::vector<std::pair<double, int>> order;
   order.clear();
   for (int f : faces) {
@@ -176,7 +176,13 @@ std::tuple<int, Proj, double> nearest_first(const std::vector<Aabb>& boxes, doub
       best_proj = pr;
     }
   }
-  return {best, best_proj, dmin};
+  Result r;
+  r.found = best >= 0 && dmin <= radius;
+  if (r.found) {
+    r.face = best;
+    r.proj = best_proj;
+  }
+  return r;
 }
 
 // Closest point over `faces`.
@@ -184,7 +190,7 @@ SurfaceProjection closest_over(const Surface& s, const std::vector<FaceX>& X, co
                                double inflation, std::vector<int>& faces, const Vec3& p, double radius,
                                const ProjectionOptions& opt, const std::vector<unsigned>* free) {
   constexpr double reject = std::numeric_limits<double>::infinity();
-  const auto [f, pr, d] = nearest_first<Projection>(boxes, inflation, faces, p, [&](int f, Projection& pr) {
+  return nearest_first<SurfaceProjection>(boxes, inflation, faces, p, radius, [&](int f, Projection& pr) {
     pr = project(s.faces[f].kind, X[f], s.normal_sign, p, opt);
     if (!pr.valid) return reject;
     if (free && pr.location != Location::Interior && pr.d < 0.0) {
@@ -193,13 +199,6 @@ SurfaceProjection closest_over(const Surface& s, const std::vector<FaceX>& X, co
     }
     return pr.distance;
   });
-  SurfaceProjection best;
-  best.found = f >= 0 && d <= radius;
-  if (best.found) {
-    best.face = f;
-    best.proj = pr;
-  }
-  return best;
 }
 }  // namespace
 
@@ -214,18 +213,11 @@ SurfaceNormalProjection SurfaceSearch::along_normals(const Vec3& p, double insid
   thread_local std::vector<int> cand;
   candidates(p, cand);
   // |d| = |p - s|: the pruning of the closest point applies unchanged
-  const auto [f, pr, d] =
-      nearest_first<NormalFieldProjection>(boxes_, radius_, cand, p, [&](int f, NormalFieldProjection& pr) {
+  return nearest_first<SurfaceNormalProjection>(
+      boxes_, radius_, cand, p, radius_, [&](int f, NormalFieldProjection& pr) {
         pr = project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol);
         return pr.valid ? std::abs(pr.d) : std::numeric_limits<double>::infinity();
       });
-  SurfaceNormalProjection best;
-  best.found = f >= 0 && d <= radius_;
-  if (best.found) {
-    best.face = f;
-    best.proj = pr;
-  }
-  return best;
 }
 
 SurfaceProjection SurfaceSearch::closest_brute_force(const Vec3& p, const ProjectionOptions& opt) const {

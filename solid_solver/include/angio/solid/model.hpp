@@ -150,8 +150,8 @@ class SolidModel {
   double time_ = 0.0;
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
-  std::vector<double> ref_volume_;        // reference volume per element (stabilization)
-  double stabilization_force_norm_();
+  Vec stab_diag_ = nullptr;               // c·V_a per owned dof (NewtonOptions::stabilization); null when off
+  double stabilization_(Vec r, Mat K);
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;
