@@ -194,7 +194,7 @@ std::string write_summary(const std::string& path, const BeamModel& m,
   os << "  \"units\": {\"length\": \"mm\", \"force\": \"N\", \"moment\": \"N mm\", \"time\": \"s\"},\n";
   os << "  \"num_nodes\": " << m.num_nodes() << ",\n  \"num_elements\": " << m.num_elements() << ",\n";
   os << "  \"generated_stent\": " << (generated_stent ? "true" : "false") << ",\n";
-  const double D0 = m.diameter(true);  // initial (crimped) diameter
+  const double D0 = initial.diameter;  // initial (crimped) diameter
   double Dmax = D0, tmax = 0;
   for (const auto& s : steps)
     if (s.diameter > Dmax) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "angio/beam/axis_bow.hpp"
+#include "angio/beam/ring_axis.hpp"
 #include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 
@@ -19,6 +20,7 @@ BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string&
     out_->write_step(*scene_.model, 0, scene_.time.start);  // reference state
   }
   const BeamModel& m = *scene_.model;
+  initial_.diameter = m.diameter(true);
   if (scene_.stent) stent_measures(initial_, true);
   LOG_INFO("beam model: " << m.num_nodes() << " nodes, " << m.num_elements() << " elements, "
                           << m.num_free_dofs() << " free DOFs, " << m.num_sample_points()
@@ -32,8 +34,12 @@ BeamSolverParticipant::~BeamSolverParticipant() = default;
 void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const {
   const BeamModel& m = *scene_.model;
   if (!scene_.stent) return;
-  r.distal_diameter = m.diameter(scene_.stent->distal_nodes, reference);
-  r.central_diameter = m.diameter(scene_.stent->central_nodes, reference);
+  // diameters about the axis of the deformed stent (ring_axis.hpp), the reference axis for one ring
+  const std::vector<Vec3>& x = m.positions(reference);
+  const Axis axis = ring_centroid_axis(scene_.stent->ring_crowns, x).value_or(m.axis);
+  r.diameter = mean_diameter(axis, x);
+  r.distal_diameter = mean_diameter(axis, x, scene_.stent->distal_nodes);
+  r.central_diameter = mean_diameter(axis, x, scene_.stent->central_nodes);
   const auto at = [&](int n) { return reference ? m.reference_position(n) : m.position(n); };
   std::vector<double> s(m.num_nodes());  // arc length of each node's foot on the device axis
   for (int n = 0; n < m.num_nodes(); ++n) s[n] = m.axis.project(at(n)).s;

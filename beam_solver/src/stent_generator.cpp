@@ -54,8 +54,12 @@ StentMesh generate(const StentParameters& p, const geometry::Centerline* centerl
     return static_cast<int>(m.nodes.size()) - 1;
   };
   auto crown_z = [&](int k, int j) { return k * p.ring_pitch + ((j % 2) ? p.strut_height : 0.0); };
+  m.ring_crowns.resize(p.rings);
   for (int k = 0; k < p.rings; ++k)
-    for (int j = 0; j < nc; ++j) crown_node[{k, j}] = add_node(j * dth, crown_z(k, j));
+    for (int j = 0; j < nc; ++j) {
+      crown_node[{k, j}] = add_node(j * dth, crown_z(k, j));
+      m.ring_crowns[k].push_back(crown_node[{k, j}]);
+    }
   // a polyline on the cylinder from (th0, z0) to (th1, z1) with n elements
   auto add_line = [&](int a, int b, double th0, double z0, double th1, double z1, int n, int kind,
                       int group) {

@@ -83,10 +83,17 @@ void SolidRunner::balloon_diameters(double& mid, double& end0, double& end1) con
   mid = end0 = end1 = 0.0;
   if (!scene_.balloon_diameter) return;
   const auto& d = *scene_.balloon_diameter;
+  // Twice the mean distance of a ring's nodes (one material cross-section, nodes evenly spread
+  // around) from their centroid: the centroid follows the deformed balloon axis, so a balloon that
+  // moves or straightens (curved device, paper §3.2) is not measured from its reference axis.
   auto diam = [&](const std::vector<int>& ring) {
+    if (ring.empty()) return 0.0;
+    Vec3d c = Vec3d::Zero();
+    for (int n : ring) c += model_->position(n);
+    c /= double(ring.size());
     double sum = 0.0;
-    for (int n : ring) sum += d.radius(model_->position(n));  // from the (curved) reference axis
-    return ring.empty() ? 0.0 : 2.0 * sum / double(ring.size());
+    for (int n : ring) sum += (model_->position(n) - c).norm();
+    return 2.0 * sum / double(ring.size());
   };
   mid = diam(ring_mid_);
   end0 = diam(ring_end0_);

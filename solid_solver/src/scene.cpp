@@ -262,7 +262,7 @@ SolidScene read_solid_scene(const Node& root) {
       DiameterSpec d;
       d.node_set = "balloon_outer";
       d.axis = axis;
-      d.centerline = curved;  // curved balloon: arc-length stations, radii from the centerline
+      d.centerline = curved;  // curved balloon: arc-length stations
       double smin = std::numeric_limits<double>::max(), smax = -smin;
       for (const auto& x : m.X) {
         const double s = d.station(x);

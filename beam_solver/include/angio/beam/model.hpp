@@ -123,6 +123,7 @@ class BeamModel {
   int num_free_dofs() const { return nfree_; }
   const Vec3& reference_position(int n) const { return X_[n]; }
   const Vec3& position(int n) const { return x_[n]; }
+  const std::vector<Vec3>& positions(bool reference = false) const { return reference ? X_ : x_; }
   const Quat& rotation(int n) const { return R_[n]; }
   std::array<int, 2> element_nodes(int e) const { return elem_nodes_[e]; }
   const ElementReference& element_reference(int e) const { return eref_[e]; }

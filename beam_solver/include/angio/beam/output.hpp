@@ -53,11 +53,11 @@ struct StepRecord {
   double axis_radius = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Writes summary.json; returns the text written. `initial`: the stent measures of the reference
-// state (generated stents).
+// Writes summary.json; returns the text written. `initial`: the measures of the reference state
+// (its diameter for every model, the stent measures for generated stents).
 std::string write_summary(const std::string& path, const BeamModel& m,
                           const std::vector<StepRecord>& steps, bool generated_stent,
-                          const std::string& status, double newton_seconds = 0.0,
-                          long newton_iterations = 0, const StepRecord& initial = StepRecord{});
+                          const std::string& status, double newton_seconds, long newton_iterations,
+                          const StepRecord& initial);
 
 }  // namespace angio::beam

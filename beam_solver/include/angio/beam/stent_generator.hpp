@@ -53,6 +53,7 @@ struct StentMesh {
   std::vector<int> ring_fixation_nodes;  // 4 bottom crowns of every ring, 90° apart
   std::vector<int> distal_nodes;   // outer crowns of the end rings (dogboning)
   std::vector<int> central_nodes;  // crowns of the middle ring(s)
+  std::vector<std::vector<int>> ring_crowns;  // crowns of each ring, rings in order (ring_axis.hpp)
   std::vector<Vec3> axis;         // device axis polyline
   int num_struts = 0, num_connectors = 0;
 };

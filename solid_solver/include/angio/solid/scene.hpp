@@ -30,18 +30,13 @@ struct FixedSpec {
 struct DiameterSpec {
   std::string node_set;     // outer surface nodes
   Axis axis;
-  // Curved balloon (mesh.centerline): stations are arc lengths along the centerline and radii are
-  // distances from it (Centerline::closest), not from the straight `axis`.
+  // Curved balloon (mesh.centerline): stations are arc lengths along the centerline
+  // (Centerline::closest), not coordinates along the straight `axis`. The diameter at a station is
+  // measured about the centroid of its ring of nodes (SolidRunner::balloon_diameters).
   std::optional<geometry::Centerline> centerline;
   double s_mid = 0.0, s_end0 = 0.0, s_end1 = 0.0;  // axial coordinates (arc lengths) along the axis
   double station(const Vec3d& X) const {
     return centerline ? centerline->closest(X).s : (X - axis.origin).dot(axis.direction);
-  }
-  double radius(const Vec3d& x) const {
-    if (centerline) return centerline->closest(x).distance;
-    Vec3d r = x - axis.origin;
-    r -= r.dot(axis.direction) * axis.direction;
-    return r.norm();
   }
 };
 
