@@ -1,6 +1,7 @@
 #include "angio/coupler/coupling_loop.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
@@ -40,6 +41,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
 
     bool converged = false, participant_failed = false;
     std::string failure;
+    double smallest = std::numeric_limits<double>::infinity();  // residual, since the last restart
+    int k_restart = 0;  // iteration of the last restart: the acceleration counts from there
     for (int k = 0; k < settings.max_iterations; ++k) {
       auto t0 = Clock::now();
       participant::SolveStats bs = scheme->solve_beam(beam);
@@ -80,7 +83,19 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
         converged = true;
         break;
       }
-      scheme->next_iterate(acc, k);
+      // A residual far above the smallest of the step means the acceleration's model has turned
+      // against the map (IQN-ILS columns from another contact state): drop it and restart from
+      // the current iterate, as at the start of a step, instead of following it to max_iterations.
+      if (settings.restart_growth > 0.0 && rn > settings.restart_growth * smallest) {
+        LOG_DEBUG("step " << rep.step << " iteration " << k << ": residual " << rn << " > "
+                          << settings.restart_growth << " x " << smallest << ", acceleration restarted");
+        acc.begin_step();
+        ++rep.restarts;
+        k_restart = k;
+        smallest = rn;
+      }
+      smallest = std::min(smallest, rn);
+      scheme->next_iterate(acc, k - k_restart);
       rep.omega = acc.last_factor();
     }
 

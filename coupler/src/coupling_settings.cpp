@@ -9,7 +9,7 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   auto c = root.optional("coupling");
   if (!c) return s;
   c->check_keys({"scheme", "acceleration", "initial_relaxation", "max_relaxation", "max_iterations",
-                 "rel_tol", "abs_tol", "strict", "prediction", "record", "iqn"});
+                 "rel_tol", "abs_tol", "strict", "restart_growth", "prediction", "record", "iqn"});
   s.scheme = c->choice_or("scheme", {"dirichlet-neumann", "robin"}, s.scheme);
   s.acceleration = c->choice_or("acceleration", {"aitken", "iqn-ils", "constant"}, s.acceleration);
   if (c->has("initial_relaxation")) s.initial_relaxation = c->in_range("initial_relaxation", 1e-6, 2.0);
@@ -32,6 +32,11 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   if (s.rel_tol == 0.0 && s.abs_tol == 0.0)
     c->fail("a positive coupling.rel_tol or coupling.abs_tol (both are 0: nothing can converge)");
   s.strict = c->boolean_or("strict", s.strict);
+  if (c->has("restart_growth")) {
+    s.restart_growth = c->non_negative_or("restart_growth", 0.0);
+    if (s.restart_growth != 0.0 && !(s.restart_growth > 1.0))
+      c->child("restart_growth").fail("0 (never restart) or a factor > 1");
+  }
   s.prediction = c->choice_or("prediction", {"constant", "extrapolate"}, s.prediction);
   s.record = c->boolean_or("record", s.record);
   return s;

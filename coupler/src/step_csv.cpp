@@ -9,7 +9,7 @@ StepCsv::StepCsv(const std::string& path) : out_(path) {
   if (!out_) throw std::runtime_error(path + ": cannot open for writing");
   out_ << "step,time,pressure,coupling_iterations,residual,omega,cuts,converged,beam_time,"
           "solid_time,messaging_time,wall_time,n_active,min_gap,contact_force_x,contact_force_y,"
-          "contact_force_z\n";
+          "contact_force_z,restarts\n";
   out_.flush();
 }
 
@@ -19,7 +19,7 @@ void StepCsv::write(const StepReport& r, double pressure, double messaging) {
        << r.omega << ',' << r.cuts << ',' << (r.converged ? 1 : 0) << ',' << r.beam_time << ','
        << r.solid_time << ',' << messaging << ',' << r.wall_time << ',' << r.contact.n_active
        << ',' << r.contact.min_gap << ',' << r.contact.total_force[0] << ','
-       << r.contact.total_force[1] << ',' << r.contact.total_force[2] << '\n';
+       << r.contact.total_force[1] << ',' << r.contact.total_force[2] << ',' << r.restarts << '\n';
   // Flushed per step: a run that fails later leaves every committed step readable.
   out_.flush();
 }

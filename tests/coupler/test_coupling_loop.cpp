@@ -148,3 +148,58 @@ TEST(CouplingLoop, RobinSchemeNeedsABeamThatTakesPlanes) {
     EXPECT_NE(std::string(e.what()).find("robin"), std::string::npos) << e.what();
   }
 }
+
+namespace {
+// An acceleration whose model turns bad after three updates of a step (as IQN-ILS does with
+// columns from another contact state): relaxes with ω = 0.5 at first, then steps against the
+// residual. The k it is given must restart from 0 when the loop restarts it.
+class SpoilingAcceleration : public coupler::Acceleration {
+ public:
+  void begin_step() override {
+    calls_ = 0;
+    ++begins;
+  }
+  Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) override {
+    EXPECT_EQ(k, calls_) << "iteration index since the (re)start";
+    return q + (calls_++ < 3 ? 0.5 : -0.5) * r;
+  }
+  void end_step(bool) override {}
+  double last_factor() const override { return 0.5; }
+  std::string name() const override { return "spoiling"; }
+  int begins = 0;
+
+ private:
+  int calls_ = 0;
+};
+}  // namespace
+
+// Consistency: with eps/kb = 0.5 the relaxed map contracts by 0.25 per good update and grows by
+// 1.75 per bad one. Without a restart the bad model keeps the residual growing and the step cannot
+// converge (cut to the minimum step, StepFailure); with restart_growth = 2 the loop drops the model
+// when the residual doubles, and every restart gains 0.25³ x 1.75² ≈ 0.05, so it reaches the
+// analytic fixed point.
+TEST(CouplingLoop, ResidualGrowthRestartsTheAcceleration) {
+  coupler::CouplingSettings s;
+  s.rel_tol = 1e-10;
+  s.abs_tol = 1e-12;
+  s.max_iterations = 60;
+  {
+    test::SpringBeam beam;
+    test::WallSolid wall;
+    wall.eps = 0.5;
+    SpoilingAcceleration acc;
+    auto t = ramp(1);
+    t.min_step = 0.5;
+    EXPECT_THROW(coupler::run_coupled(beam, wall, t, s, acc), StepFailure);
+  }
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  wall.eps = 0.5;
+  s.restart_growth = 2.0;
+  SpoilingAcceleration acc;
+  const auto reports = run_ramp(beam, wall, 1, s, acc);
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_GT(reports[0].restarts, 0);
+  EXPECT_EQ(acc.begins, 1 + reports[0].restarts);
+  EXPECT_NEAR(beam.x_committed[0], 1.0 + analytic_q(beam, wall) / beam.kb, 1e-8);
+}

@@ -23,6 +23,7 @@ struct StepReport {
   std::vector<double> residuals;   // ||r_k|| per iteration of that attempt
   double omega = 0.0;              // last relaxation factor
   int cuts = 0;                    // rejected attempts before acceptance
+  int restarts = 0;                // acceleration restarts in the accepted attempt (restart_growth)
   bool converged = true;           // false: accepted with a warning (strict: false)
   double beam_time = 0.0;          // s in beam solves (incl. messaging when remote)
   double solid_time = 0.0;         // s in solid solves (incl. messaging when remote)

@@ -9,6 +9,8 @@
 //     rel_tol: 1.0e-4             # ||r|| <= rel_tol·||q~|| + abs_tol·sqrt(len)
 //     abs_tol: 1.0e-6             # N/mm
 //     strict: true                # hitting max_iterations rejects the step (false: accept + warn)
+//     restart_growth: 0           # > 1: restart the acceleration (drop its model) when the residual
+//                                 # exceeds restart_growth × the smallest of the step (0: never)
 //     prediction: extrapolate     # constant | extrapolate: first iterate of a step
 //     record: false               # record every exchange into <run-dir>/exchanges.angiorec
 #pragma once
@@ -32,6 +34,7 @@ struct CouplingSettings {
   double rel_tol = 1e-4;
   double abs_tol = 1e-6;
   bool strict = true;
+  double restart_growth = 0.0;
   std::string prediction = "extrapolate";
   bool record = false;
 };
