@@ -1,5 +1,6 @@
 #include "angio/beam/model.hpp"
 
+#include "angio/beam/ring_axis.hpp"
 #include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 #include "angio/participant/plane_penalty.hpp"
@@ -228,17 +229,7 @@ std::vector<Vec3> BeamModel::sample_load_nodal_forces() const {
   return f;
 }
 
-double BeamModel::diameter(bool reference) const {
-  double s = 0;
-  for (const auto& x : reference ? X_ : x_) s += axis.project(x).r;
-  return 2.0 * s / std::max(1, num_nodes());
-}
-double BeamModel::diameter(const std::vector<int>& nodes, bool reference) const {
-  const auto& pos = reference ? X_ : x_;
-  double s = 0;
-  for (int n : nodes) s += axis.project(pos.at(n)).r;
-  return nodes.empty() ? 0.0 : 2.0 * s / nodes.size();
-}
+double BeamModel::diameter(bool reference) const { return mean_diameter(axis, positions(reference)); }
 
 void BeamModel::set_time(double t) {
   time_ = t;

@@ -206,7 +206,8 @@ std::string write_summary(const std::string& path, const BeamModel& m,
      << ", \"time_of_max\": " << num(tmax) << ", \"final\": " << num(Dfinal)
      << ", \"recoil\": " << num(Dmax - Dfinal) << ", \"recoil_percent\": "
      << num(Dmax > 0 ? 100.0 * (Dmax - Dfinal) / Dmax : 0.0)
-     << ", \"definition\": \"2 x mean radial distance of all nodes from the device axis\"},\n";
+     << ", \"definition\": \"2 x mean radial distance of all nodes from the device axis"
+     << (generated_stent ? " of the deformed stent (polyline through the ring centroids)" : "") << "\"},\n";
   if (generated_stent && !steps.empty()) {
     // dogboning = (D_distal − D_central)/D_distal; foreshortening = (L0 − L)/L0
     double dbmax = -1e300, tdb = 0;

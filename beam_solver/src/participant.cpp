@@ -40,18 +40,17 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   r.diameter = mean_diameter(axis, x);
   r.distal_diameter = mean_diameter(axis, x, scene_.stent->distal_nodes);
   r.central_diameter = mean_diameter(axis, x, scene_.stent->central_nodes);
-  const auto at = [&](int n) { return reference ? m.reference_position(n) : m.position(n); };
   std::vector<double> s(m.num_nodes());  // arc length of each node's foot on the device axis
-  for (int n = 0; n < m.num_nodes(); ++n) s[n] = m.axis.project(at(n)).s;
+  for (int n = 0; n < m.num_nodes(); ++n) s[n] = m.axis.project(x[n]).s;
   const auto [smin, smax] = std::minmax_element(s.begin(), s.end());
   r.length = *smax - *smin;
   std::vector<Vec3> distal, central;
   std::vector<double> distal_s;
   for (int n : scene_.stent->distal_nodes) {
-    distal.push_back(at(n));
+    distal.push_back(x[n]);
     distal_s.push_back(s[n]);
   }
-  for (int n : scene_.stent->central_nodes) central.push_back(at(n));
+  for (int n : scene_.stent->central_nodes) central.push_back(x[n]);
   const AxisBow b = stent_axis_bow(distal, distal_s, central);
   r.axis_sagitta = b.sagitta;
   r.axis_radius = b.radius;

@@ -85,11 +85,11 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       }
       // A residual far above the smallest of the step means the acceleration's model has turned
       // against the map (IQN-ILS columns from another contact state): drop it and restart from
-      // the current iterate, as at the start of a step, instead of following it to max_iterations.
+      // the current iterate (columns of earlier steps too) instead of following it to max_iterations.
       if (settings.restart_growth > 0.0 && rn > settings.restart_growth * smallest) {
         LOG_DEBUG("step " << rep.step << " iteration " << k << ": residual " << rn << " > "
                           << settings.restart_growth << " x " << smallest << ", acceleration restarted");
-        acc.begin_step();
+        acc.restart();
         ++rep.restarts;
         k_restart = k;
         smallest = rn;

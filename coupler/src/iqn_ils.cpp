@@ -20,6 +20,11 @@ void IqnIls::begin_step() {
   qt_prev_.resize(0);
 }
 
+void IqnIls::restart() {
+  begin_step();
+  previous_.clear();
+}
+
 Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) {
   const Eigen::VectorXd qt = q + r;
   if (k > 0 && r_prev_.size() == r.size()) {

@@ -135,3 +135,22 @@ TEST(IqnIls, VanishingModelStepRestartsWithRelaxation) {
   EXPECT_EQ(acc.restarts(), 1);
   EXPECT_TRUE(q.isApprox(Eigen::Vector2d(4.0, 0.0))) << q.transpose();
 }
+
+TEST(IqnIls, RestartDropsTheColumnsOfEarlierStepsToo) {
+  // Unlike begin_step() (a new step keeps the reused columns, see
+  // ReusedColumnsSolveTheNextStepWithTheFirstUpdate), restart() forgets everything: its first
+  // update relaxes with ω₀ and uses no column.
+  LinearMap m;
+  IqnIls acc(IqnIlsOptions{0.1, 4, 100, 1e-10});
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+  ASSERT_GE(run_step(acc, m, Eigen::VectorXd::Ones(6), q, 10, 1e-9), 0);
+  const Eigen::VectorXd r = Eigen::VectorXd::Ones(6);
+  acc.begin_step();
+  acc.update(q, r, 0);
+  EXPECT_GT(acc.last_columns(), 0);
+  acc.restart();
+  const Eigen::VectorXd next = acc.update(q, r, 0);
+  EXPECT_EQ(acc.last_columns(), 0);
+  EXPECT_DOUBLE_EQ(acc.last_factor(), 0.1);
+  EXPECT_TRUE(next.isApprox(q + 0.1 * r));
+}

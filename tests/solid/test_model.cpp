@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <numbers>
 
 #include "angio/scene/node.hpp"
@@ -48,6 +49,24 @@ ModelOptions direct_options() {
   o.newton.atol = 1e-12;
   return o;
 }
+
+// The distorted unit cube pressed by a follower pressure p on the face x = 1, rollers on the
+// planes x = 0, y = 0, z = 0, at t = 1.
+std::unique_ptr<SolidModel> pressed_cube(const Mesh& m, const LayerMaterial& mat, const ModelOptions& o, double p) {
+  Mesh mm = m;
+  mm.surfaces.push_back(faces_at_x1(mm));
+  mm.orient_surfaces();
+  auto model = std::make_unique<SolidModel>(PETSC_COMM_WORLD, mm, std::vector<LayerMaterial>{mat}, o);
+  for (int c = 0; c < 3; ++c) {
+    std::vector<int> plane;
+    for (size_t n = 0; n < mm.X.size(); ++n)
+      if (std::abs(mm.X[n](c)) < 1e-12) plane.push_back(int(n));
+    model->add_dirichlet({plane, c, [](const Vec3d&, double) { return 0.0; }});
+  }
+  model->add_pressure({"right", [p](double) { return p; }});
+  model->set_time(1.0);
+  return model;
+}
 }  // namespace
 
 // Patch test through the whole distributed path: boundary nodes prescribed to the homogeneous
@@ -83,24 +102,13 @@ TEST(Model, PatchTestSolveAllElementTypes) {
 TEST(Model, PressureOnCubeAllFaceTypes) {
   const double E = 2.0, nu = 0.3, p = 2e-5;
   for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
-    Mesh m = angio_test::cube_mesh(t, 2, 0.08, 9);
-    const SurfaceSet right = faces_at_x1(m);
-    ASSERT_FALSE(right.faces.empty());
-    m.surfaces.push_back(right);
-    m.orient_surfaces();
-    SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {E, nu}, {}}}, direct_options());
-    for (int c = 0; c < 3; ++c) {
-      std::vector<int> plane;
-      for (size_t n = 0; n < m.X.size(); ++n)
-        if (std::abs(m.X[n](c)) < 1e-12) plane.push_back(int(n));
-      model.add_dirichlet({plane, c, [](const Vec3d&, double) { return 0.0; }});
-    }
-    model.add_pressure({"right", [p](double) { return p; }});
-    model.set_time(1.0);
-    const auto rep = model.solve();
+    const Mesh m = angio_test::cube_mesh(t, 2, 0.08, 9);
+    ASSERT_FALSE(faces_at_x1(m).faces.empty());
+    auto model = pressed_cube(m, LayerMaterial{"cube", {E, nu}, {}}, direct_options(), p);
+    const auto rep = model->solve();
     ASSERT_TRUE(rep.converged) << rep.message;
     for (size_t n = 0; n < m.X.size(); ++n) {
-      const Vec3d X = m.X[n], u = model.displacement(int(n));
+      const Vec3d X = m.X[n], u = model->displacement(int(n));
       EXPECT_NEAR(u.x(), -p / E * X.x(), 1e-3 * p / E) << name(t);
       EXPECT_NEAR(u.y(), nu * p / E * X.y(), 1e-3 * p / E) << name(t);
     }
@@ -116,31 +124,20 @@ TEST(Model, PressureOnCubeAllFaceTypes) {
 TEST(Model, StabilizationConvergesToTheEquilibrium) {
   const double p = 0.05;
   auto solve_cube = [&](double c, int cycles, std::vector<double>& force, int& max_newton) {
-    Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
-    const SurfaceSet right = faces_at_x1(m);
-    m.surfaces.push_back(right);
-    m.orient_surfaces();
+    const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
     ModelOptions o = direct_options();
     o.newton.stabilization = c;
-    SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {2.0, 0.3}, {}}}, o);
-    for (int k = 0; k < 3; ++k) {
-      std::vector<int> plane;
-      for (size_t n = 0; n < m.X.size(); ++n)
-        if (std::abs(m.X[n](k)) < 1e-12) plane.push_back(int(n));
-      model.add_dirichlet({plane, k, [](const Vec3d&, double) { return 0.0; }});
-    }
-    model.add_pressure({"right", [p](double) { return p; }});
-    model.set_time(1.0);
+    auto model = pressed_cube(m, LayerMaterial{"cube", {2.0, 0.3}, {}}, o, p);
     max_newton = 0;
     for (int i = 0; i < cycles; ++i) {
-      const auto rep = model.solve();
+      const auto rep = model->solve();
       EXPECT_TRUE(rep.converged) << rep.message;
       force.push_back(rep.stabilization_force);
       max_newton = std::max(max_newton, rep.iterations);
-      model.commit();
+      model->commit();
     }
     std::vector<Vec3d> u;
-    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model.displacement(int(n)));
+    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model->displacement(int(n)));
     return u;
   };
   std::vector<double> f0, f;

@@ -155,10 +155,10 @@ class BeamModel {
   // Nodal forces consistent with sample_contact_loads() (for output), N per node.
   std::vector<Vec3> sample_load_nodal_forces() const;
 
-  // Mean radial distance of the nodes from the axis, times 2: of all nodes, or of the given ones
-  // (0 for none), at the current or the reference positions.
+  // Mean radial distance of all nodes from the (reference) device axis, times 2, at the current or
+  // the reference positions (mean_diameter, ring_axis.hpp; generated stents are measured about
+  // their deformed axis instead).
   double diameter(bool reference = false) const;
-  double diameter(const std::vector<int>& nodes, bool reference = false) const;
 
   // ---- state ----
   void set_time(double t);  // evaluates load curves and applies prescribed values

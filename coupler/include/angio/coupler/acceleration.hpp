@@ -14,6 +14,9 @@ class Acceleration {
   virtual ~Acceleration() = default;
   // Called at the start of every load step (also after a rejected attempt).
   virtual void begin_step() = 0;
+  // Drops everything the acceleration has learned, also from earlier steps, so that the next
+  // update (k = 0) starts afresh from the current iterate (coupling.restart_growth).
+  virtual void restart() { begin_step(); }
   // Given the current input q_k and the residual r_k = q~_k − q_k of iteration k (0-based within
   // the step), returns the next input q_{k+1}.
   virtual Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) = 0;

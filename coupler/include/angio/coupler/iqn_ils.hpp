@@ -34,6 +34,7 @@ class IqnIls : public Acceleration {
  public:
   explicit IqnIls(IqnIlsOptions o);
   void begin_step() override;
+  void restart() override;  // also drops the columns of earlier steps
   Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) override;
   void end_step(bool accepted) override;
   double last_factor() const override { return factor_; }
