@@ -239,7 +239,7 @@ std::string write_summary(const std::string& path, const BeamModel& m,
        << ", \"axis_radius_at_max_diameter\": " << num(pk.axis_radius)
        << ", \"axis_radius_final\": " << num(fin.axis_radius)
        << ", \"definitions\": \"D_distal: outer crowns of the end rings, D_central: crowns of the middle ring(s); "
-          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = axial extent of the nodes; "
+          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = extent of the nodes along the deformed axis (through the ring centroids); "
           "axis sagitta: distance of the middle crowns' centroid from the chord through the centroids of the end "
           "rings' outer crowns, axis radius: radius of the circle through the three (null: straight)\"},\n";
   }

@@ -40,10 +40,11 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   r.diameter = mean_diameter(axis, x);
   r.distal_diameter = mean_diameter(axis, x, scene_.stent->distal_nodes);
   r.central_diameter = mean_diameter(axis, x, scene_.stent->central_nodes);
-  std::vector<double> s(m.num_nodes());  // arc length of each node's foot on the device axis
+  // length along the deformed axis: a curved device that moves sideways would seem to lengthen on
+  // the fixed reference centerline
+  r.length = length_along(axis, x);
+  std::vector<double> s(m.num_nodes());  // arc length of each node's foot on the reference axis: sorts the two ends
   for (int n = 0; n < m.num_nodes(); ++n) s[n] = m.axis.project(x[n]).s;
-  const auto [smin, smax] = std::minmax_element(s.begin(), s.end());
-  r.length = *smax - *smin;
   std::vector<Vec3> distal, central;
   std::vector<double> distal_s;
   for (int n : scene_.stent->distal_nodes) {

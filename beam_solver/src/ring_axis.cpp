@@ -1,5 +1,8 @@
 #include "angio/beam/ring_axis.hpp"
 
+#include <algorithm>
+#include <limits>
+
 namespace angio::beam {
 
 std::optional<Axis> ring_centroid_axis(const std::vector<std::vector<int>>& ring_crowns,
@@ -24,6 +27,17 @@ double mean_diameter(const Axis& axis, const std::vector<Vec3>& x, const std::ve
   }
   for (int n : nodes) s += axis.project(x.at(n)).r;
   return 2.0 * s / double(nodes.size());
+}
+
+double length_along(const Axis& axis, const std::vector<Vec3>& x) {
+  if (x.empty()) return 0.0;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& p : x) {
+    const double s = axis.project(p).s;
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+  }
+  return hi - lo;
 }
 
 }  // namespace angio::beam

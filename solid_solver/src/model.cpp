@@ -67,18 +67,18 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
   }
   partition_();
   setup_petsc_();
-  if (opt_.newton.stabilization > 0.0) {
-    // c·V_a per dof: each owned element adds c·V_e/n_e to its nodes (a lumped "mass" of unit density)
-    ANGIO_PETSC(VecDuplicate(r_, &stab_diag_));
-    ANGIO_PETSC(VecSet(stab_diag_, 0.0));
+  if (opt_.newton.damping > 0.0) {
+    // η·V_a per dof: each owned element adds η·V_e/n_e to its nodes (a lumped "mass" of unit density)
+    ANGIO_PETSC(VecDuplicate(r_, &damping_diag_));
+    ANGIO_PETSC(VecSet(damping_diag_, 0.0));
     for (int e : local_elements_) {
       const auto& el = mesh_.elements[e];
-      const double m = opt_.newton.stabilization * volume[e] / el.nn();
+      const double m = opt_.newton.damping * volume[e] / el.nn();
       for (int a = 0; a < el.nn(); ++a)
-        for (int k = 0; k < 3; ++k) ANGIO_PETSC(VecSetValue(stab_diag_, 3 * perm_[el.n[a]] + k, m, ADD_VALUES));
+        for (int k = 0; k < 3; ++k) ANGIO_PETSC(VecSetValue(damping_diag_, 3 * perm_[el.n[a]] + k, m, ADD_VALUES));
     }
-    ANGIO_PETSC(VecAssemblyBegin(stab_diag_));
-    ANGIO_PETSC(VecAssemblyEnd(stab_diag_));
+    ANGIO_PETSC(VecAssemblyBegin(damping_diag_));
+    ANGIO_PETSC(VecAssemblyEnd(damping_diag_));
   }
   u_.assign(3 * mesh_.X.size(), 0.0);
   u_committed_ = u_;
@@ -89,7 +89,7 @@ SolidModel::~SolidModel() {
   if (K_) MatDestroy(&K_);
   if (r_) VecDestroy(&r_);
   if (du_) VecDestroy(&du_);
-  if (stab_diag_) VecDestroy(&stab_diag_);
+  if (damping_diag_) VecDestroy(&damping_diag_);
   if (full_) VecDestroy(&full_);
   if (scatter_) VecScatterDestroy(&scatter_);
   if (options_) PetscOptionsDestroy(&options_);
@@ -350,7 +350,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     ANGIO_PETSC(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
     ANGIO_PETSC(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
   }
-  if (stab_diag_) stabilization_(r, K);
+  if (damping_diag_) damping_(r, K);
   if (!dirichlet_rows_.empty() && apply_bc_) {
     std::vector<PetscScalar> zeros(dirichlet_rows_.size(), 0.0);
     ANGIO_PETSC(VecSetValues(r, PetscInt(zeros.size()), dirichlet_rows_.data(), zeros.data(), INSERT_VALUES));
@@ -441,7 +441,7 @@ SolveReport SolidModel::solve() {
     if (res <= no.atol || (it > 0 && res <= no.rtol * res0)) {
       rep.converged = true;
       rep.message = "converged";
-      if (stab_diag_) rep.stabilization_force = stabilization_(nullptr, nullptr);
+      if (damping_diag_) rep.damping_force = damping_(nullptr, nullptr);
       break;
     }
     if (it >= no.max_iterations) {
@@ -517,28 +517,42 @@ SolveReport SolidModel::solve() {
   return rep;
 }
 
-double SolidModel::stabilization_(Vec r, Mat K) {
-  // f_a = c·V_a·(u_a − u_a,committed) on the owned dofs, added to r (if given); its tangent c·V_a on
-  // the diagonal of K (if given). Returns the global norm of f.
+double SolidModel::damping_(Vec r, Mat K) {
+  // f_a = η·V_a·(u_a − u_a,committed)/Δt on the owned dofs, added to r (if given); its tangent η·V_a/Δt
+  // on the diagonal of K (if given). Returns the global norm of f.
+  const double dt = time_ - committed_time_;
+  if (!(dt > 0.0))
+    throw std::logic_error("solid damping needs a time increment since the last commit (t = " + std::to_string(time_) +
+                           ", committed t = " + std::to_string(committed_time_) + ")");
   const PetscScalar* d;
   PetscScalar* rr = nullptr;
-  ANGIO_PETSC(VecGetArrayRead(stab_diag_, &d));
+  ANGIO_PETSC(VecGetArrayRead(damping_diag_, &d));
   if (r) ANGIO_PETSC(VecGetArray(r, &rr));
   double local = 0.0;
   for (int i = 3 * node_begin_; i < 3 * node_end_; ++i) {
-    const double f = d[i - 3 * node_begin_] * (u_[i] - u_committed_[i]);
+    const double f = d[i - 3 * node_begin_] * (u_[i] - u_committed_[i]) / dt;
     if (rr) rr[i - 3 * node_begin_] += f;
     local += f * f;
   }
   if (r) ANGIO_PETSC(VecRestoreArray(r, &rr));
-  ANGIO_PETSC(VecRestoreArrayRead(stab_diag_, &d));
-  if (K) ANGIO_PETSC(MatDiagonalSet(K, stab_diag_, ADD_VALUES));
+  ANGIO_PETSC(VecRestoreArrayRead(damping_diag_, &d));
+  if (K) {
+    Vec diag;
+    ANGIO_PETSC(VecDuplicate(damping_diag_, &diag));
+    ANGIO_PETSC(VecCopy(damping_diag_, diag));
+    ANGIO_PETSC(VecScale(diag, 1.0 / dt));
+    ANGIO_PETSC(MatDiagonalSet(K, diag, ADD_VALUES));
+    ANGIO_PETSC(VecDestroy(&diag));
+  }
   double global = 0.0;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
   return std::sqrt(global);
 }
 
-void SolidModel::commit() { u_committed_ = u_; }
+void SolidModel::commit() {
+  u_committed_ = u_;
+  committed_time_ = time_;
+}
 void SolidModel::rollback() { u_ = u_committed_; }
 
 void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir) const {

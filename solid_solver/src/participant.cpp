@@ -51,7 +51,7 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     ring_end1_ = ring(d.s_end1);
   }
   time_ = scene_.time.start;
-  model_->set_time(time_);
+  model_->start_at(time_);
   if (!run_dir.empty()) {
     dir_ = run_dir + "/solid";
     writer_ = std::make_unique<FieldWriter>(*model_, dir_);
@@ -145,7 +145,7 @@ void SolidRunner::end_step(bool accept) {
     os << std::setprecision(4) << "solid step " << committed_ << " t=" << time_;
     for (const auto& [label, p] : h.pressures) os << " " << label << "=" << p << "MPa";
     os << " newton=" << last_.iterations << " |r|=" << std::scientific << std::setprecision(2) << last_.residual;
-    if (last_.stabilization_force > 0.0) os << " |f_stab|=" << last_.stabilization_force;
+    if (last_.damping_force > 0.0) os << " |f_damp|=" << last_.damping_force;
     os << std::defaultfloat << std::setprecision(4);
     if (scene_.balloon_diameter) os << " D_mid=" << h.d_mid << " D_ends=" << h.d_end0 << "/" << h.d_end1 << "mm";
     os << " max_p1[";

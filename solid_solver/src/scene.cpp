@@ -326,7 +326,7 @@ SolidScene read_solid_scene(const Node& root) {
                                           "contiguous");
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
-      n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "stabilization"});
+      n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping"});
       auto& no = sc.options.newton;
       no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
       no.rtol = n->positive_or("rtol", no.rtol);
@@ -334,7 +334,7 @@ SolidScene read_solid_scene(const Node& root) {
       no.line_search = n->boolean_or("line_search", no.line_search);
       no.max_line_search = int(n->integer_or("max_line_search", no.max_line_search, 0));
       no.verbose = n->boolean_or("verbose", no.verbose);
-      no.stabilization = n->non_negative_or("stabilization", no.stabilization);
+      no.damping = n->non_negative_or("damping", no.damping);
     }
   }
   return sc;

@@ -1,4 +1,4 @@
-// Stent diameter about the axis of the deformed stent (ring_axis.hpp).
+// Stent diameter about, and length along, the axis of the deformed stent (ring_axis.hpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -66,6 +66,46 @@ TEST(RingAxis, CurvedStentKeepsTheCrimpedDiameter) {
   EXPECT_NEAR(mean_diameter(*axis, m.nodes), p.crimped_diameter, bound);
   EXPECT_NEAR(mean_diameter(*axis, m.nodes, m.central_nodes), p.crimped_diameter, bound);
   EXPECT_NEAR(mean_diameter(*axis, m.nodes, m.distal_nodes), p.crimped_diameter, bound);
+}
+
+// Length along the deformed axis. Analytic: the straight 4-ring stent spans rings × pitch = 6 mm
+// (its end crowns lie on the end planes, the ring axis extends along the same line), after any
+// rigid motion too, where its extent along the reference axis shrinks by the rotation (cos 0.4).
+// Consistency: warped onto an arc of R = 15 mm without stretching, the 11-ring stent spans 16.5 mm
+// of arc. Along the ring polyline the interior is shorter by the chord-vs-arc difference; the
+// extent is set by the end crowns, which project onto the straight extensions beyond the end
+// centroids: a crown on the outer side of the bend, at r + δ from the polyline (δ = h²/(8R), the
+// centroid's own offset), lies (h/2)(1 + (r + δ)/R) beyond along the arc tangent, plus r·sin(φ/2)
+// because the extension follows the end chord, turned by half the chord angle φ = pitch/R. So
+// 16.5 ≤ L ≤ 16.5 + 2[(h/2)(r + δ)/R + r φ/2] (+0.117 mm; measured +0.083). The same stent moved
+// 0.5 mm sideways is as long along its own axis.
+TEST(RingAxis, LengthAlongTheDeformedAxis) {
+  StentParameters p;
+  p.rings = 4;
+  const StentMesh m = generate_corrugated_rings(p);
+  const Eigen::Matrix3d Q = Eigen::AngleAxisd(0.4, Vec3(1, 0, 0)).toRotationMatrix();
+  std::vector<Vec3> x;
+  for (const auto& X : m.nodes) x.push_back(Q * X + Vec3(0.3, -0.1, 2.0));
+  const double L = p.rings * p.ring_pitch;
+  EXPECT_NEAR(length_along(*ring_centroid_axis(m.ring_crowns, m.nodes), m.nodes), L, 1e-9);
+  EXPECT_NEAR(length_along(*ring_centroid_axis(m.ring_crowns, x), x), L, 1e-9);
+  Axis reference;
+  reference.points = m.axis;
+  EXPECT_LT(length_along(reference, x), L * std::cos(0.4) + 2 * p.crimped_diameter * std::sin(0.4) + 1e-9);
+
+  const double R = 15.0;
+  StentParameters q;
+  q.rings = 11;
+  const StentMesh c = generate_corrugated_rings(q, arc(R, 24.0));
+  const double Lc = q.rings * q.ring_pitch;
+  const double r = 0.5 * q.crimped_diameter, h = q.strut_height, delta = h * h / (8 * R);
+  const double excess = 2 * (0.5 * h * (r + delta) / R + r * 0.5 * q.ring_pitch / R);
+  const double Lcurved = length_along(*ring_centroid_axis(c.ring_crowns, c.nodes), c.nodes);
+  EXPECT_GE(Lcurved, Lc - Lc * std::pow(q.ring_pitch / R, 2) / 24);
+  EXPECT_LE(Lcurved, Lc + excess);
+  std::vector<Vec3> moved;
+  for (const auto& X : c.nodes) moved.push_back(X + Vec3(0.5, 0, 0));
+  EXPECT_NEAR(length_along(*ring_centroid_axis(c.ring_crowns, moved), moved), Lcurved, 1e-9);
 }
 
 // One ring has no axis of its own: the caller keeps the reference axis.

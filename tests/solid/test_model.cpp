@@ -115,24 +115,27 @@ TEST(Model, PressureOnCubeAllFaceTypes) {
   }
 }
 
-// Stabilization (NewtonOptions::stabilization) is artificial damping toward the committed state.
-// Consistency: (1) the first stabilized solve stops short of the equilibrium and reports the force
-// it needed; (2) repeated solve + commit at the same load is a proximal-point iteration whose fixed
-// point is the unstabilized equilibrium (the added force vanishes there), so it converges to the
-// solution without stabilization; (3) Newton stays quadratic with the added diagonal (few
-// iterations per solve), which checks the tangent term.
-TEST(Model, StabilizationConvergesToTheEquilibrium) {
+// Damping (NewtonOptions::damping) is artificial viscosity over the pseudo-time.
+// Consistency: (1) the first damped solve stops short of the equilibrium and reports the force it
+// needed; (2) repeated solve + commit at the same load while the time advances is a proximal-point
+// iteration whose fixed point is the undamped equilibrium (the viscous force vanishes at rest), so
+// it converges to the solution without damping; (3) Newton stays quadratic with the added diagonal
+// (few iterations per solve), which checks the tangent term; (4) the force is viscous: η with Δt
+// gives exactly the solution of 2η with 2Δt, and the same η over half the step damps harder.
+TEST(Model, DampingConvergesToTheEquilibrium) {
   const double p = 0.05;
-  auto solve_cube = [&](double c, int cycles, std::vector<double>& force, int& max_newton) {
+  auto solve_cube = [&](double eta, double dt, int cycles, std::vector<double>& force, int& max_newton) {
     const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
     ModelOptions o = direct_options();
-    o.newton.stabilization = c;
+    o.newton.damping = eta;
     auto model = pressed_cube(m, LayerMaterial{"cube", {2.0, 0.3}, {}}, o, p);
+    model->start_at(0.0);
     max_newton = 0;
     for (int i = 0; i < cycles; ++i) {
+      model->set_time((i + 1) * dt);
       const auto rep = model->solve();
       EXPECT_TRUE(rep.converged) << rep.message;
-      force.push_back(rep.stabilization_force);
+      force.push_back(rep.damping_force);
       max_newton = std::max(max_newton, rep.iterations);
       model->commit();
     }
@@ -140,24 +143,28 @@ TEST(Model, StabilizationConvergesToTheEquilibrium) {
     for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model->displacement(int(n)));
     return u;
   };
+  auto max_diff = [](const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+    double d = 0.0;
+    for (size_t n = 0; n < a.size(); ++n) d = std::max(d, (a[n] - b[n]).norm());
+    return d;
+  };
   std::vector<double> f0, f;
   int it0 = 0, it = 0;
-  const auto u_ref = solve_cube(0.0, 1, f0, it0);
-  const auto u1 = solve_cube(0.5, 1, f, it);
-  double err1 = 0, scale = 0;
-  for (size_t n = 0; n < u_ref.size(); ++n) {
-    err1 = std::max(err1, (u1[n] - u_ref[n]).norm());
-    scale = std::max(scale, u_ref[n].norm());
-  }
-  EXPECT_GT(err1, 0.05 * scale);  // one stabilized solve stops visibly short
+  const auto u_ref = solve_cube(0.0, 1.0, 1, f0, it0);
+  double scale = 0;
+  for (const auto& v : u_ref) scale = std::max(scale, v.norm());
+  const auto u1 = solve_cube(0.5, 1.0, 1, f, it);
+  const double err1 = max_diff(u1, u_ref);
+  EXPECT_GT(err1, 0.05 * scale);  // one damped solve stops visibly short
   EXPECT_GT(f[0], 0.0);
+  std::vector<double> g;
+  EXPECT_LT(max_diff(solve_cube(1.0, 2.0, 1, g, it), u1), 1e-12 * scale);  // η/Δt is what counts
+  EXPECT_GT(max_diff(solve_cube(0.5, 0.5, 1, g, it), u_ref), 1.2 * err1);   // a shorter step damps harder
   f.clear();
-  const auto u = solve_cube(0.5, 20, f, it);
-  double err = 0;
-  for (size_t n = 0; n < u_ref.size(); ++n) err = std::max(err, (u[n] - u_ref[n]).norm());
-  EXPECT_LT(err, 1e-8 * scale);
+  const auto u = solve_cube(0.5, 1.0, 20, f, it);
+  EXPECT_LT(max_diff(u, u_ref), 1e-8 * scale);
   EXPECT_LT(f.back(), 1e-6 * f.front());
-  EXPECT_LE(it, it0 + 1);  // quadratic Newton with the stabilization tangent
+  EXPECT_LE(it, it0 + 1);  // quadratic Newton with the damping tangent
   EXPECT_EQ(f0[0], 0.0);   // off by default
 }
 

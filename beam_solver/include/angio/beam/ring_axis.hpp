@@ -1,4 +1,4 @@
-// The axis of the deformed stent and the stent diameter about it.
+// The axis of the deformed stent, and the stent diameter about it and length along it.
 // The paper measures the stent diameter as the mean radial distance of the stent nodes from the
 // device axis (§3.1). Measured from the fixed reference axis, a device that moves or straightens
 // (the curved free expansion, §3.2) shows a diameter that is too large: a ring of radius r whose
@@ -22,5 +22,9 @@ std::optional<Axis> ring_centroid_axis(const std::vector<std::vector<int>>& ring
 
 // 2 × mean distance of the nodes `nodes` (all nodes when empty) from `axis`.
 double mean_diameter(const Axis& axis, const std::vector<Vec3>& x, const std::vector<int>& nodes = {});
+
+// Extent of the nodes' feet along `axis` (max − min arc length of their projections): the device
+// length measured along itself, which a rigid motion or a bend does not change.
+double length_along(const Axis& axis, const std::vector<Vec3>& x);
 
 }  // namespace angio::beam

@@ -38,11 +38,14 @@ struct NewtonOptions {
   bool line_search = true;   // backtracking on ||r|| (halving, up to max_line_search times)
   int max_line_search = 6;
   bool verbose = false;      // per-iteration log on rank 0
-  // Artificial damping toward the last committed state (as Abaqus' *STATIC, STABILIZE): each node
-  // gets the force c·V_a·(u_a − u_a,committed) with V_a its share of the element volumes, N/mm⁴.
-  // It carries a load step over a limit point or bifurcation of the pressure-controlled balloon,
-  // at the price of an equilibrium error of that size (reported per solve). 0 = off.
-  double stabilization = 0.0;
+  // Artificial viscous damping over the pseudo-time (as Abaqus' *STATIC, STABILIZE): each node gets
+  // the force η·V_a·(u_a − u_a,committed)/Δt, V_a its share of the element volumes, Δt the time since
+  // the last commit; η in N·s/mm⁴. It carries a load step over a limit point or bifurcation of the
+  // pressure-controlled balloon, at the price of an equilibrium error of that size (reported per
+  // solve). Being viscous, it depends on the load rate, not on the step: a cut step is damped as
+  // strongly per unit rate and its tangent term η·V_a/Δt grows, where a spring toward the committed
+  // state would weaken with the shorter increment. 0 = off.
+  double damping = 0.0;
 };
 
 struct ModelOptions {
@@ -62,7 +65,7 @@ struct SolveReport {
   double assembly_seconds = 0.0;
   double linear_seconds = 0.0;
   double total_seconds = 0.0;
-  double stabilization_force = 0.0;  // norm of the stabilization forces at the end (N)
+  double damping_force = 0.0;  // norm of the damping forces at the end (N)
 };
 
 struct PressureLoad {
@@ -94,6 +97,8 @@ class SolidModel {
 
   void set_time(double t) { time_ = t; }
   double time() const { return time_; }
+  // Start (or restart) the pseudo-time at t with the current state committed there.
+  void start_at(double t) { time_ = committed_time_ = t; }
   // Newton solve at the current time (collective). Never throws for non-convergence.
   SolveReport solve();
   void commit();    // current state becomes the committed state
@@ -147,11 +152,11 @@ class SolidModel {
   std::vector<DirichletBC> dirichlet_;
   std::vector<PetscInt> dirichlet_rows_;  // owned global rows
   ContactModel* contact_ = nullptr;
-  double time_ = 0.0;
+  double time_ = 0.0, committed_time_ = 0.0;
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
-  Vec stab_diag_ = nullptr;               // c·V_a per owned dof (NewtonOptions::stabilization); null when off
-  double stabilization_(Vec r, Mat K);
+  Vec damping_diag_ = nullptr;            // η·V_a per owned dof (NewtonOptions::damping); null when off
+  double damping_(Vec r, Mat K);
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;
