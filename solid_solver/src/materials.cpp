@@ -47,14 +47,14 @@ void add_stress(const NeoHooke& m, const Mat3& C, Mat3& S, Mat6* D) {
 
 double energy(const FiberFamily& f, const Mat3& C) {
   const double I4 = f.a0.dot(C * f.a0);
-  if (I4 <= 1.0) return 0.0;
+  if (f.tension_only && I4 <= 1.0) return 0.0;
   const double e = I4 - 1.0;
-  return f.k1 / (2.0 * f.k2) * (std::exp(f.k2 * e * e) - 1.0);
+  return f.k1 / (2.0 * f.k2) * std::expm1(f.k2 * e * e);  // expm1: no cancellation near I4 = 1
 }
 
 void add_stress(const FiberFamily& f, const Mat3& C, Mat3& S, Mat6* D) {
   const double I4 = f.a0.dot(C * f.a0);
-  if (I4 <= 1.0) return;  // fibers carry tension only
+  if (f.tension_only && I4 <= 1.0) return;  // fibers carry tension only
   const double e = I4 - 1.0;
   const double ex = std::exp(f.k2 * e * e);
   const double dpsi = f.k1 * e * ex;                                // dPsi/dI4
@@ -74,6 +74,7 @@ std::vector<FiberFamily> resolve_fibers(const LayerMaterial& m, const Frame& fra
     FiberFamily f;
     f.k1 = fs.k1;
     f.k2 = fs.k2;
+    f.tension_only = fs.tension_only;
     f.a0 = (std::cos(phi) * frame.circumferential + std::sin(phi) * frame.axial).normalized();
     out.push_back(f);
     if (fs.pair) {

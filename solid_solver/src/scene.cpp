@@ -22,15 +22,16 @@ LayerMaterial read_material(const Node& n, const std::string& name) {
   if (!(m.matrix.nu >= 0.0 && m.matrix.nu < 0.5)) n.child("nu").fail("a Poisson's ratio in [0, 0.5)");
   if (n.has("viscous")) n.child("viscous").fail("no 'viscous' entry (the viscous branch is not implemented yet)");
   if (auto f = n.optional("fibers")) {
-    if (!f->is_sequence()) f->fail("a list of fiber families {k1, k2, angle, pair}");
+    if (!f->is_sequence()) f->fail("a list of fiber families {k1, k2, angle, pair, tension_only}");
     for (size_t i = 0; i < f->size(); ++i) {
       const Node fi = f->at(i);
-      fi.check_keys({"k1", "k2", "angle", "pair"});
+      fi.check_keys({"k1", "k2", "angle", "pair", "tension_only"});
       FiberSpec s;
       s.k1 = fi.non_negative("k1");
       s.k2 = fi.positive("k2");
       s.angle_deg = fi.in_range("angle", -90.0, 90.0);
       s.pair = fi.boolean_or("pair", false);
+      s.tension_only = fi.boolean_or("tension_only", true);
       m.fibers.push_back(s);
     }
   }

@@ -118,6 +118,35 @@ TEST(Materials, FiberFamiliesTensionAndCompression) {
   EXPECT_GT(D(0, 0), 0.0);
 }
 
+// Fibers that also carry compression (tension_only = false, eq. B.4 as printed): FD of the energy
+// (the tangent is smooth through I4 = 1), the analytic uniaxial value in compression, and the
+// flag passed on from the spec.
+TEST(Materials, FibersInCompressionWhenNotTensionOnly) {
+  Frame fr;
+  fr.circumferential = Vec3d(0, 1, 0);
+  fr.axial = Vec3d(0, 0, 1);
+  fr.radial = Vec3d(1, 0, 0);
+  FiberSpec spec{1000.0, 0.01, 90.0, false};
+  spec.tension_only = false;
+  const LayerMaterial balloon{"balloon", {17.0, 0.0}, {spec}};
+  const auto fibers = resolve_fibers(balloon, fr);
+  ASSERT_EQ(fibers.size(), 1u);
+  EXPECT_FALSE(fibers[0].tension_only);
+  for (const auto& F : test_deformations()) check_material(balloon.matrix, fibers, F, 1e-6, 1e-4);
+  Mat3 F = Mat3::Identity();
+  F(2, 2) = 0.999999;  // across I4 = 1: FD stays consistent
+  check_material(balloon.matrix, fibers, F, 1e-6, 1e-4);
+  FiberFamily f{1.0, 2.0, Vec3d(1, 0, 0)};
+  f.tension_only = false;
+  F = Mat3::Identity();
+  F(0, 0) = 0.9;
+  Mat3 S = Mat3::Zero();
+  add_stress(f, F.transpose() * F, S, nullptr);
+  const double e = 0.81 - 1.0;
+  EXPECT_NEAR(S(0, 0), 2.0 * e * std::exp(2.0 * e * e), 1e-12);  // negative: the fiber pushes back
+  EXPECT_LT(S(0, 0), 0.0);
+}
+
 TEST(Materials, FiberAnglesFromFrame) {
   Frame fr;
   fr.circumferential = Vec3d(0, 1, 0);

@@ -32,12 +32,16 @@ double energy(const NeoHooke& m, const Mat3& C);
 // Adds S and D (D may be null).
 void add_stress(const NeoHooke& m, const Mat3& C, Mat3& S, Mat6* D);
 
-// One exponential fiber family (Holzapfel-Gasser-Ogden without dispersion), tension only:
-//   Psi = k1/(2 k2) (exp(k2 (I4 - 1)^2) - 1) if I4 > 1, else 0,   I4 = a0 . C a0 (|a0| = 1)
+// One exponential fiber family (Holzapfel-Gasser-Ogden without dispersion, paper eq. B.4):
+//   Psi = k1/(2 k2) (exp(k2 (I4 - 1)^2) - 1),   I4 = a0 . C a0 (|a0| = 1),
+// by default in tension only (Psi = 0 for I4 <= 1, DESIGN §3, as fibers buckle); tension_only =
+// false keeps it for I4 < 1 too, as eq. B.4 is printed (an "artificial" balloon fiber that resists
+// axial compression and hence bending).
 struct FiberFamily {
   double k1 = 0.0;
   double k2 = 0.0;
   Vec3d a0 = Vec3d::UnitX();
+  bool tension_only = true;
 };
 double energy(const FiberFamily& f, const Mat3& C);
 void add_stress(const FiberFamily& f, const Mat3& C, Mat3& S, Mat6* D);
@@ -50,6 +54,7 @@ struct FiberSpec {
   double k2 = 0.0;
   double angle_deg = 0.0;
   bool pair = false;
+  bool tension_only = true;
 };
 
 // A layer / block material: Neo-Hooke ground matrix plus fiber families.
