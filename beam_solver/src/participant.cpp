@@ -43,13 +43,11 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   // length along the deformed axis: a curved device that moves sideways would seem to lengthen on
   // the fixed reference centerline
   r.length = length_along(axis, x);
-  std::vector<double> s(m.num_nodes());  // arc length of each node's foot on the reference axis: sorts the two ends
-  for (int n = 0; n < m.num_nodes(); ++n) s[n] = m.axis.project(x[n]).s;
   std::vector<Vec3> distal, central;
-  std::vector<double> distal_s;
+  std::vector<double> distal_s;  // arc length of the foot on the reference axis: sorts the two ends
   for (int n : scene_.stent->distal_nodes) {
     distal.push_back(x[n]);
-    distal_s.push_back(s[n]);
+    distal_s.push_back(m.axis.project(x[n]).s);
   }
   for (int n : scene_.stent->central_nodes) central.push_back(x[n]);
   const AxisBow b = stent_axis_bow(distal, distal_s, central);

@@ -79,6 +79,7 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
     }
     ANGIO_PETSC(VecAssemblyBegin(damping_diag_));
     ANGIO_PETSC(VecAssemblyEnd(damping_diag_));
+    ANGIO_PETSC(VecDuplicate(damping_diag_, &damping_tangent_));
   }
   u_.assign(3 * mesh_.X.size(), 0.0);
   u_committed_ = u_;
@@ -90,6 +91,7 @@ SolidModel::~SolidModel() {
   if (r_) VecDestroy(&r_);
   if (du_) VecDestroy(&du_);
   if (damping_diag_) VecDestroy(&damping_diag_);
+  if (damping_tangent_) VecDestroy(&damping_tangent_);
   if (full_) VecDestroy(&full_);
   if (scatter_) VecScatterDestroy(&scatter_);
   if (options_) PetscOptionsDestroy(&options_);
@@ -525,25 +527,24 @@ double SolidModel::damping_(Vec r, Mat K) {
     throw std::logic_error("solid damping needs a time increment since the last commit (t = " + std::to_string(time_) +
                            ", committed t = " + std::to_string(committed_time_) + ")");
   const PetscScalar* d;
-  PetscScalar* rr = nullptr;
+  PetscScalar *rr = nullptr, *kk = nullptr;
   ANGIO_PETSC(VecGetArrayRead(damping_diag_, &d));
   if (r) ANGIO_PETSC(VecGetArray(r, &rr));
+  if (K) ANGIO_PETSC(VecGetArray(damping_tangent_, &kk));
   double local = 0.0;
   for (int i = 3 * node_begin_; i < 3 * node_end_; ++i) {
-    const double f = d[i - 3 * node_begin_] * (u_[i] - u_committed_[i]) / dt;
-    if (rr) rr[i - 3 * node_begin_] += f;
+    const int j = i - 3 * node_begin_;
+    const double f = d[j] * (u_[i] - u_committed_[i]) / dt;
+    if (rr) rr[j] += f;
+    if (kk) kk[j] = d[j] / dt;
     local += f * f;
   }
   if (r) ANGIO_PETSC(VecRestoreArray(r, &rr));
-  ANGIO_PETSC(VecRestoreArrayRead(damping_diag_, &d));
   if (K) {
-    Vec diag;
-    ANGIO_PETSC(VecDuplicate(damping_diag_, &diag));
-    ANGIO_PETSC(VecCopy(damping_diag_, diag));
-    ANGIO_PETSC(VecScale(diag, 1.0 / dt));
-    ANGIO_PETSC(MatDiagonalSet(K, diag, ADD_VALUES));
-    ANGIO_PETSC(VecDestroy(&diag));
+    ANGIO_PETSC(VecRestoreArray(damping_tangent_, &kk));
+    ANGIO_PETSC(MatDiagonalSet(K, damping_tangent_, ADD_VALUES));
   }
+  ANGIO_PETSC(VecRestoreArrayRead(damping_diag_, &d));
   double global = 0.0;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
   return std::sqrt(global);

@@ -82,7 +82,6 @@ void reset_reply(const participant::SamplePoints& pts, participant::ContactReply
 void SolidRunner::balloon_diameters(double& mid, double& end0, double& end1) const {
   mid = end0 = end1 = 0.0;
   if (!scene_.balloon_diameter) return;
-  const auto& d = *scene_.balloon_diameter;
   // Twice the mean distance of a ring's nodes (one material cross-section, nodes evenly spread
   // around) from their centroid: the centroid follows the deformed balloon axis, so a balloon that
   // moves or straightens (curved device, paper §3.2) is not measured from its reference axis.

@@ -98,7 +98,10 @@ class SolidModel {
   void set_time(double t) { time_ = t; }
   double time() const { return time_; }
   // Start (or restart) the pseudo-time at t with the current state committed there.
-  void start_at(double t) { time_ = committed_time_ = t; }
+  void start_at(double t) {
+    time_ = t;
+    commit();
+  }
   // Newton solve at the current time (collective). Never throws for non-convergence.
   SolveReport solve();
   void commit();    // current state becomes the committed state
@@ -156,6 +159,7 @@ class SolidModel {
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
   Vec damping_diag_ = nullptr;            // η·V_a per owned dof (NewtonOptions::damping); null when off
+  Vec damping_tangent_ = nullptr;         // η·V_a/Δt, refilled per assembly (no allocation in Newton)
   double damping_(Vec r, Mat K);
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;
