@@ -136,6 +136,10 @@ def main():
     ap.add_argument("--solid-cmd", help="replace the solid participant executable (same CLI)")
     args = ap.parse_args()
 
+    # One BLAS thread per process: the solid runs one MPI rank per core, and a threaded OpenBLAS under
+    # MUMPS would oversubscribe the cores (a user's explicit setting wins).
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
     scene_path = Path(args.scene).resolve()
     scene = load_scene(scene_path)
     has_stent = "stent" in scene
@@ -219,7 +223,9 @@ def main():
         name, rc = failed
         print(f"launch: error: {name} exited with code {rc} after {wall:.1f} s "
               f"(log: {run_dir / (name + '.log')}); the other processes were stopped", file=sys.stderr)
-        return 10 + [n for n, _ in plan].index(name)
+        # 2 is every executable's "bad scene or mesh" (the message names the file and key): passed on
+        # unchanged, so that a bad scene is exit code 2 from the launcher as from the solvers
+        return 2 if rc == 2 else 10 + [n for n, _ in plan].index(name)
     print(f"launch: finished in {wall:.1f} s; results in {run_dir}")
     report = ROOT / "scripts" / "report.py"
     if report.is_file():

@@ -5,9 +5,9 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
-  libeigen3-dev libsuitesparse-dev
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread
   petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev libhdf5-dev
-  flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev
+  flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev nlohmann-json3-dev
   libgtest-dev googletest
   python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml
 )

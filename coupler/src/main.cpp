@@ -58,7 +58,10 @@ int run(const cli::Parser& args) {
   const scene::TimeSettings time = scene::time_settings(root);
   const coupler::CouplingSettings settings = coupler::coupling_settings(root);
   const scene::LoadCurves curves = scene::load_curves(root);
-  const auto pressure_curve = curves.count("pressure") ? curves.at("pressure") : scene::LoadCurve::constant(0.0);
+  // the balloon pressure (column `pressure` of coupling.csv): balloon.pressure of the scene, 0 without
+  scene::ScaledCurve balloon_pressure;
+  if (const auto b = root.optional("balloon"); b && b->has("pressure"))
+    balloon_pressure = scene::scaled_curve(*b, "pressure", curves);
   const fs::path run_dir = args.get("run-dir");
   fs::create_directories(run_dir);
   const std::string run_id = args.get("run-id");
@@ -91,7 +94,7 @@ int run(const cli::Parser& args) {
       const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
       const double step_messaging = messaging - messaging_before;
       messaging_before = messaging;
-      const double p = pressure_curve.value(r.time);
+      const double p = balloon_pressure.at(r.time);
       csv.write(r, p, step_messaging);
       LOG_INFO("step " << r.step << " t = " << r.time << " s p = " << p << " MPa: " << r.iterations
                        << " coupling iterations, residual "

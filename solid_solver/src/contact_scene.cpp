@@ -109,9 +109,15 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
     LOG_INFO(os.str());
   };
   runner.set_stent_contact(&composite_);
+  // forces on the endothelium per contact, in the runner's summary
+  if (stent_) runner.add_contact_report("stent", stent_.get());
+  if (balloon_artery_) runner.add_contact_report("balloon", balloon_artery_.get());
 }
 
-ContactSetup::~ContactSetup() { runner_.set_stent_contact(nullptr); }
+ContactSetup::~ContactSetup() {
+  runner_.set_stent_contact(nullptr);
+  runner_.clear_contact_reports();
+}
 
 double ContactSetup::contact_seconds() const {
   double s = 0.0;

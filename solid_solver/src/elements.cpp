@@ -158,7 +158,7 @@ namespace {
 template <int NN>
 bool element_internal_fixed(ElemType t, const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud, const NeoHooke& mat,
                             const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
-                            ElementStress* out) {
+                            ElementStress* out, const ViscousHistory* visc) {
   using MatN3 = Eigen::Matrix<double, NN, 3>;
   using VecF = Eigen::Matrix<double, 3 * NN, 1>;
   using MatK = Eigen::Matrix<double, 3 * NN, 3 * NN>;
@@ -197,6 +197,15 @@ bool element_internal_fixed(ElemType t, const Eigen::MatrixXd& Xd, const Eigen::
     if (!(detF > 0.0)) ok = false;
     const Mat3 C = F.transpose() * F;
     stress_tangent(mat, fibers, C, S, K ? &D : nullptr);
+    if (visc) {  // S = S∞ + Q (eq. B.8), Q from eq. B.7 integrated over the step
+      const Vec6 s_inf = to_voigt_stress(S);
+      double factor = 1.0;
+      const Vec6 Q = viscous_update(visc->branch, visc->dt, visc->Q_n[q], visc->S_n[q], s_inf, &factor);
+      if (visc->Q_out) visc->Q_out[q] = Q;
+      if (visc->S_out) visc->S_out[q] = s_inf;
+      S += from_voigt_stress(Q);
+      if (K) D *= factor;
+    }
     const double dV = detJ0 * rule[q].w;
     for (int a = 0; a < NN; ++a)
       for (int i = 0; i < 3; ++i) {
@@ -232,11 +241,11 @@ bool element_internal_fixed(ElemType t, const Eigen::MatrixXd& Xd, const Eigen::
 
 bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixXd& u, const NeoHooke& mat,
                       const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
-                      ElementStress* out) {
+                      ElementStress* out, const ViscousHistory* visc) {
   switch (t) {
-    case ElemType::Hex8: return element_internal_fixed<8>(t, X, u, mat, fibers, f, K, out);
-    case ElemType::Tet4: return element_internal_fixed<4>(t, X, u, mat, fibers, f, K, out);
-    case ElemType::Tet10: return element_internal_fixed<10>(t, X, u, mat, fibers, f, K, out);
+    case ElemType::Hex8: return element_internal_fixed<8>(t, X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Tet4: return element_internal_fixed<4>(t, X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Tet10: return element_internal_fixed<10>(t, X, u, mat, fibers, f, K, out, visc);
   }
   return false;
 }

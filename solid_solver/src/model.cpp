@@ -83,6 +83,27 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
   }
   u_.assign(3 * mesh_.X.size(), 0.0);
   u_committed_ = u_;
+  visc_offset_.assign(local_elements_.size(), -1);
+  int nvisc = 0;
+  for (size_t i = 0; i < local_elements_.size(); ++i) {
+    const auto& el = mesh_.elements[local_elements_[i]];
+    if (!materials_[el.block].viscous) continue;
+    visc_offset_[i] = nvisc;
+    nvisc += int(volume_rule(el.type).size());
+  }
+  visc_Q_.assign(nvisc, Vec6::Zero());  // the reference state is stress-free
+  visc_S_.assign(nvisc, Vec6::Zero());
+}
+
+const ViscousHistory* SolidModel::viscous_history_(size_t i, ViscousHistory& h) const {
+  if (visc_offset_[i] < 0) return nullptr;
+  const auto& el = mesh_.elements[local_elements_[i]];
+  h.branch = *materials_[el.block].viscous;
+  h.dt = time_ - committed_time_;
+  h.Q_n = visc_Q_.data() + visc_offset_[i];
+  h.S_n = visc_S_.data() + visc_offset_[i];
+  h.Q_out = h.S_out = nullptr;
+  return &h;
 }
 
 SolidModel::~SolidModel() {
@@ -317,11 +338,14 @@ bool SolidModel::assemble(Vec r, Mat K) {
     ANGIO_PETSC(VecSetValues(r, m, idx.data(), fe.data(), ADD_VALUES));
     if (K) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
   };
-  for (int e : local_elements_) {
+  ViscousHistory vh;
+  for (size_t i = 0; i < local_elements_.size(); ++i) {
+    const int e = local_elements_[i];
     const auto& el = mesh_.elements[e];
     gather_nodes(el.n.data(), el.nn(), false);
     const auto& mat = materials_[el.block].matrix;
-    if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr)) {
+    if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr, nullptr,
+                          viscous_history_(i, vh))) {
       ok = 0;
       break;
     }
@@ -550,32 +574,72 @@ double SolidModel::damping_(Vec r, Mat K) {
   return std::sqrt(global);
 }
 
+void SolidModel::element_state_(int e, Eigen::MatrixXd& X, Eigen::MatrixXd& u) const {
+  const auto& el = mesh_.elements[e];
+  X.resize(el.nn(), 3);
+  u.resize(el.nn(), 3);
+  for (int a = 0; a < el.nn(); ++a) {
+    X.row(a) = mesh_.X[el.n[a]].transpose();
+    u.row(a) = displacement(el.n[a]).transpose();
+  }
+}
+
 void SolidModel::commit() {
+  if (!visc_Q_.empty()) {  // advance the viscous history to the current state (Δt from the old commit)
+    Eigen::MatrixXd X, u;
+    Eigen::VectorXd fe;
+    ViscousHistory vh;
+    for (size_t i = 0; i < local_elements_.size(); ++i) {
+      if (!viscous_history_(i, vh)) continue;
+      // in place: each Gauss point reads its committed values before it writes the new ones
+      vh.Q_out = visc_Q_.data() + visc_offset_[i];
+      vh.S_out = visc_S_.data() + visc_offset_[i];
+      const int e = local_elements_[i];
+      const auto& el = mesh_.elements[e];
+      element_state_(e, X, u);
+      element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, nullptr, &vh);
+    }
+  }
   u_committed_ = u_;
   committed_time_ = time_;
 }
 void SolidModel::rollback() { u_ = u_committed_; }
 
-void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir) const {
+void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume) const {
   p1.resize(local_elements_.size());
   dir.resize(local_elements_.size());
+  if (volume) volume->resize(local_elements_.size());
   Eigen::MatrixXd X, u;
   Eigen::VectorXd fe;
   for (size_t i = 0; i < local_elements_.size(); ++i) {
     const int e = local_elements_[i];
     const auto& el = mesh_.elements[e];
-    X.resize(el.nn(), 3);
-    u.resize(el.nn(), 3);
-    for (int a = 0; a < el.nn(); ++a) {
-      X.row(a) = mesh_.X[el.n[a]].transpose();
-      u.row(a) = displacement(el.n[a]).transpose();
-    }
+    element_state_(e, X, u);
     ElementStress es;
-    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, &es);
+    ViscousHistory vh;
+    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, &es,
+                     viscous_history_(i, vh));
     Eigen::SelfAdjointEigenSolver<Mat3> eig(es.cauchy_avg);
     p1[i] = eig.eigenvalues()(2);
     dir[i] = eig.eigenvectors().col(2);
+    if (volume) (*volume)[i] = es.volume;
   }
+}
+
+std::vector<Vec3d> SolidModel::contact_forces(ContactModel& c) {
+  Vec f;
+  ANGIO_PETSC(VecDuplicate(r_, &f));
+  ANGIO_PETSC(VecSet(f, 0.0));
+  c.add(*this, f, nullptr);
+  ANGIO_PETSC(VecAssemblyBegin(f));
+  ANGIO_PETSC(VecAssemblyEnd(f));
+  std::vector<double> full;
+  gather_(f, full);
+  ANGIO_PETSC(VecDestroy(&f));
+  std::vector<Vec3d> out(mesh_.X.size());
+  for (size_t n = 0; n < mesh_.X.size(); ++n)
+    for (int k = 0; k < 3; ++k) out[n](k) = -full[3 * perm_[n] + k];  // residual r = f_int − f_ext
+  return out;
 }
 
 }  // namespace angio::solid

@@ -127,7 +127,8 @@ void FieldWriter::close() {
   }
 }
 
-void FieldWriter::write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir) {
+void FieldWriter::write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir,
+                             const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal) {
   const std::string g = "/steps/" + std::to_string(step);
   const long n0 = model_.owned_node_begin(), n1 = model_.owned_node_end(), N = long(model_.mesh().X.size());
   std::vector<double> u(3 * (n1 - n0));
@@ -136,6 +137,13 @@ void FieldWriter::write_step(int step, double time, const std::vector<double>& p
     for (int k = 0; k < 3; ++k) u[3 * (i - n0) + k] = d(k);
   }
   write_rows(file_, g + "/displacement", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, u.data());
+  StepInfo info{step, time, {}};
+  for (const auto& [field, values] : nodal) {
+    std::vector<double> v(n1 - n0);
+    for (long i = n0; i < n1; ++i) v[i - n0] = (*values)[model_.old_index(int(i))];
+    write_rows(file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, v.data());
+    info.nodal.push_back(field);
+  }
   for (const auto& ti : types_) {
     const long nloc = long(ti.local.size());
     std::vector<double> s(nloc), d(3 * nloc);
@@ -157,7 +165,7 @@ void FieldWriter::write_step(int step, double time, const std::vector<double>& p
     H5Gclose(grp);
   }
   H5Fflush(file_, H5F_SCOPE_GLOBAL);
-  steps_.emplace_back(step, time);
+  steps_.push_back(std::move(info));
   if (model_.rank() == 0) write_xdmf_();
 }
 
@@ -166,7 +174,7 @@ void FieldWriter::write_xdmf_() {
   std::ostringstream x;
   x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
     << "  <Grid Name=\"solid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (const auto& [step, time] : steps_) {
+  for (const auto& [step, time, nodal] : steps_) {
     const std::string g = "solid.h5:/steps/" + std::to_string(step);
     x << "   <Grid Name=\"step_" << step << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
       << "    <Time Value=\"" << time << "\"/>\n";
@@ -183,7 +191,12 @@ void FieldWriter::write_xdmf_() {
         << "     </Geometry>\n"
         << "     <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n      <DataItem Dimensions=\""
         << N << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/displacement</DataItem>\n"
-        << "     </Attribute>\n"
+        << "     </Attribute>\n";
+      for (const auto& field : nodal)
+        x << "     <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"Node\">\n      <DataItem Dimensions=\""
+          << N << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/" << field << "</DataItem>\n"
+          << "     </Attribute>\n";
+      x
         << "     <Attribute Name=\"block_id\" AttributeType=\"Scalar\" Center=\"Cell\">\n      <DataItem Dimensions=\""
         << ti.total << "\" NumberType=\"Int\" Format=\"HDF\">solid.h5:/mesh/" << tn << "/block_id</DataItem>\n"
         << "     </Attribute>\n"

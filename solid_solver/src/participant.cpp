@@ -6,7 +6,10 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "angio/common/log.hpp"
 
@@ -49,6 +52,19 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     ring_mid_ = ring(d.s_mid);
     ring_end0_ = ring(d.s_end0);
     ring_end1_ = ring(d.s_end1);
+  }
+  if (scene_.lumen) {
+    const auto& mesh = model_->mesh();
+    const SurfaceSet* endo = mesh.surface(scene_.lumen->node_set);
+    std::vector<int> nodes;
+    for (const auto& f : endo->faces)
+      for (int a = 0; a < f.nn(); ++a) nodes.push_back(f.n[a]);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    std::vector<double> st(nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i) st[i] = scene_.lumen->station(mesh.X[nodes[i]]);
+    lumen_ = LumenProfile(nodes, st, scene_.lumen_max_stations);
+    endothelium_area_ = nodal_areas(mesh, *endo);
   }
   time_ = scene_.time.start;
   model_->start_at(time_);
@@ -156,23 +172,122 @@ void SolidRunner::end_step(bool accept) {
   }
 }
 
+void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const {
+  // every local element as (block, p1, volume, current centroid) gathered on rank 0
+  const auto& mesh = model_->mesh();
+  const auto& le = model_->local_elements();
+  std::vector<double> mine;
+  mine.reserve(6 * le.size());
+  for (size_t i = 0; i < le.size(); ++i) {
+    const auto& el = mesh.elements[le[i]];
+    Vec3d c = Vec3d::Zero();
+    for (int a = 0; a < el.nn(); ++a) c += model_->position(el.n[a]);
+    c /= double(el.nn());
+    mine.insert(mine.end(), {double(el.block), p1[i], vol[i], c(0), c(1), c(2)});
+  }
+  int size = 1;
+  MPI_Comm_size(comm_, &size);
+  const int count = int(mine.size());
+  std::vector<int> counts(size), displs(size, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+  std::vector<double> all;
+  if (rank_ == 0) {
+    for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+    all.resize(displs.back() + counts.back());
+  }
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm_);
+  const size_t nb = mesh.blocks.size();
+  s.stress.assign(nb, BlockStress{});
+  if (rank_ != 0) return;
+  std::vector<std::vector<double>> values(nb), weights(nb);
+  std::vector<double> best(nb, -std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k + 5 < all.size(); k += 6) {
+    const int b = int(all[k]);
+    values[b].push_back(all[k + 1]);
+    weights[b].push_back(all[k + 2]);
+    if (all[k + 1] > best[b]) {
+      best[b] = all[k + 1];
+      s.stress[b].max = all[k + 1];
+      s.stress[b].where = Vec3d(all[k + 3], all[k + 4], all[k + 5]);
+    }
+  }
+  for (size_t b = 0; b < nb; ++b) s.stress[b].p99 = weighted_quantile(values[b], weights[b], 0.99);
+}
+
+void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_pressure) {
+  const auto& mesh = model_->mesh();
+  std::vector<Vec3d> x(mesh.X.size());
+  for (size_t n = 0; n < x.size(); ++n) x[n] = model_->position(int(n));
+  // maximum displacement per part (the prestressed state: paper 0.14 mm)
+  std::map<std::string, double> umax;
+  for (const auto& el : mesh.elements) {
+    double& m = umax[mesh.blocks[el.block].part];
+    for (int a = 0; a < el.nn(); ++a) m = std::max(m, (x[el.n[a]] - mesh.X[el.n[a]]).norm());
+  }
+  for (const auto& [part, u] : umax) s.max_displacement.emplace_back(part, u);
+  if (lumen_.empty()) return;
+  s.lumen_diameter = lumen_.diameters(x);
+  // contact on the endothelium: force per contact model, and the pressure field of all of them
+  contact_pressure.assign(mesh.X.size(), 0.0);
+  std::vector<Vec3d> total(mesh.X.size(), Vec3d::Zero());
+  for (const auto& [name, c] : contact_reports_) {
+    const std::vector<Vec3d> f = model_->contact_forces(*c);
+    double sum = 0.0;
+    for (size_t n = 0; n < f.size(); ++n)
+      if (endothelium_area_[n] > 0.0) {
+        sum += f[n].norm();
+        total[n] += f[n];
+      }
+    s.artery_contact_force.emplace_back(name, sum);
+  }
+  for (size_t n = 0; n < total.size(); ++n)
+    if (endothelium_area_[n] > 0.0) contact_pressure[n] = total[n].norm() / endothelium_area_[n];
+  if (stent_contact_) {
+    std::vector<double> gap, weight;
+    stent_contact_->gaps(*model_, scene_.lumen->node_set, gap, weight);
+    if (!gap.empty()) {
+      s.apposition = apposition(gap, weight, scene_.apposition_threshold);
+      if (rank_ == 0 && writer_) write_apposition_csv_(gap, weight);
+    }
+  }
+}
+
+void SolidRunner::write_apposition_csv_(const std::vector<double>& gap, const std::vector<double>& weight) const {
+  // the last committed step only: one row per strut sample point
+  const std::string tmp = dir_ + "/apposition.csv.tmp";
+  {
+    std::ofstream f(tmp);
+    f << "# stent apposition at t = " << time_ << " s: gap = distance from the strut surface to the endothelium (mm; "
+      << "negative: embedded; inf: no wall within the contact search radius), weight = arc length (mm); "
+      << "malapposed if gap > " << scene_.apposition_threshold << " mm\n";
+    f << "point,weight,gap,malapposed\n" << std::setprecision(10);
+    for (size_t i = 0; i < gap.size(); ++i)
+      f << i << "," << weight[i] << "," << gap[i] << "," << (gap[i] <= scene_.apposition_threshold ? 0 : 1) << "\n";
+  }
+  std::rename(tmp.c_str(), (dir_ + "/apposition.csv").c_str());
+}
+
 void SolidRunner::record_and_write_(int step, double time) {
-  std::vector<double> p1;
+  std::vector<double> p1, vol;
   std::vector<Vec3d> dir;
-  model_->element_stress(p1, dir);
+  model_->element_stress(p1, dir, &vol);
+  StepSummary s;
+  s.step = step;
+  s.time = time;
+  for (const auto& p : scene_.pressures) s.pressures.emplace_back(p.label, p.value * p.curve.value(time));
+  block_stress_(p1, vol, s);
+  // the maxima on every rank (the log line and the history of the followers)
   const size_t nb = model_->mesh().blocks.size();
-  std::vector<double> local(nb, -std::numeric_limits<double>::max()), global(nb);
+  std::vector<double> local(nb, -std::numeric_limits<double>::max());
   const auto& le = model_->local_elements();
   for (size_t i = 0; i < le.size(); ++i) {
     const int b = model_->mesh().elements[le[i]].block;
     local[b] = std::max(local[b], p1[i]);
   }
-  MPI_Allreduce(local.data(), global.data(), int(nb), MPI_DOUBLE, MPI_MAX, comm_);
-  StepSummary s;
-  s.step = step;
-  s.time = time;
-  for (const auto& p : scene_.pressures) s.pressures.emplace_back(p.label, p.value * p.curve.value(time));
-  s.max_p1 = global;
+  s.max_p1.resize(nb);
+  MPI_Allreduce(local.data(), s.max_p1.data(), int(nb), MPI_DOUBLE, MPI_MAX, comm_);
+  std::vector<double> contact_pressure;
+  artery_measures_(s, contact_pressure);
   balloon_diameters(s.d_mid, s.d_end0, s.d_end1);
   if (step > 0) {
     s.newton_iterations = last_.iterations;
@@ -180,49 +295,90 @@ void SolidRunner::record_and_write_(int step, double time) {
     s.solve_seconds = last_.total_seconds;
   }
   history_.push_back(s);
-  if (writer_ && (step % scene_.output_every == 0 || step == 0)) writer_->write_step(step, time, p1, dir);
+  if (writer_ && (step % scene_.output_every == 0 || step == 0)) {
+    std::vector<std::pair<std::string, const std::vector<double>*>> nodal;
+    if (!contact_pressure.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);
+    writer_->write_step(step, time, p1, dir, nodal);
+  }
   if (writer_ && rank_ == 0) write_summary_json_();
 }
 
 void SolidRunner::write_summary_json_() const {
-  std::ostringstream j;
-  j << std::setprecision(10);
-  j << "{\n  \"units\": {\"length\": \"mm\", \"stress\": \"MPa\", \"time\": \"s\"},\n";
-  j << "  \"stress_measure\": \"max over elements of the first principal Cauchy stress of the Gauss-point averaged "
-       "element stress\",\n";
-  j << "  \"blocks\": [";
-  for (size_t b = 0; b < model_->mesh().blocks.size(); ++b)
-    j << (b ? ", " : "") << "{\"id\": " << b << ", \"name\": \"" << model_->mesh().blocks[b].name
-      << "\", \"part\": \"" << model_->mesh().blocks[b].part << "\"}";
-  j << "],\n";
+  using nlohmann::ordered_json;
+  const auto& mesh = model_->mesh();
+  auto finite = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr); };
+  ordered_json j;
+  j["units"] = {{"length", "mm"}, {"stress", "MPa"}, {"force", "N"}, {"time", "s"}};
+  j["stress_measure"] =
+      "first principal Cauchy stress of the Gauss-point averaged element stress: max over the elements of a block "
+      "(with the current centroid of that element) and the 99th percentile by reference volume";
+  j["blocks"] = ordered_json::array();
+  for (size_t b = 0; b < mesh.blocks.size(); ++b)
+    j["blocks"].push_back({{"id", b}, {"name", mesh.blocks[b].name}, {"part", mesh.blocks[b].part}});
   if (scene_.balloon_diameter) {
     const auto& d = *scene_.balloon_diameter;
-    j << "  \"balloon_diameter_stations\": {\"mid\": " << d.s_mid << ", \"end0\": " << d.s_end0
-      << ", \"end1\": " << d.s_end1 << ", \"measure\": \"2 x mean distance of the outer-surface node ring from the axis"
-      << (d.centerline ? " (the curved centerline of the balloon)" : "") << "\"},\n";
+    j["balloon_diameter_stations"] = {
+        {"mid", d.s_mid},
+        {"end0", d.s_end0},
+        {"end1", d.s_end1},
+        {"measure", std::string("2 x mean distance of the outer-surface node ring from the axis") +
+                        (d.centerline ? " (the curved centerline of the balloon)" : "")}};
   }
-  j << "  \"steps\": [\n";
-  for (size_t i = 0; i < history_.size(); ++i) {
-    const auto& s = history_[i];
-    j << "    {\"step\": " << s.step << ", \"time\": " << s.time;
-    for (const auto& [label, p] : s.pressures) j << ", \"" << label << "\": " << p;
-    j << ", \"max_principal_stress\": {";
-    for (size_t b = 0; b < s.max_p1.size(); ++b)
-      j << (b ? ", " : "") << "\"" << model_->mesh().blocks[b].name << "\": " << s.max_p1[b];
-    j << "}";
+  if (!lumen_.empty()) {
+    j["lumen_stations"] = lumen_.stations();
+    j["lumen_measure"] =
+        "lumen diameter per station along the reference vessel axis: 2 x mean distance of the endothelium nodes of the "
+        "station from their centroid";
+    j["artery_contact_force_measure"] = "sum over the endothelium nodes of |nodal contact force| (N), per contact";
+    j["apposition_threshold"] = scene_.apposition_threshold;
+  }
+  j["steps"] = ordered_json::array();
+  for (const auto& s : history_) {
+    ordered_json e;
+    e["step"] = s.step;
+    e["time"] = s.time;
+    for (const auto& [label, p] : s.pressures) e[label] = p;
+    ordered_json mx, p99, where;
+    for (size_t b = 0; b < s.max_p1.size(); ++b) {
+      mx[mesh.blocks[b].name] = finite(s.max_p1[b]);
+      if (b < s.stress.size()) {
+        p99[mesh.blocks[b].name] = finite(s.stress[b].p99);
+        const Vec3d& w = s.stress[b].where;
+        where[mesh.blocks[b].name] = {w(0), w(1), w(2)};
+      }
+    }
+    e["max_principal_stress"] = mx;
+    e["p99_principal_stress"] = p99;
+    e["max_principal_stress_at"] = where;
+    for (const auto& [part, u] : s.max_displacement) e["max_displacement"][part] = u;
     if (scene_.balloon_diameter) {
       const double dog = s.d_mid > 0 ? (0.5 * (s.d_end0 + s.d_end1) - s.d_mid) / s.d_mid : 0.0;
-      j << ", \"balloon_outer_diameter\": {\"mid\": " << s.d_mid << ", \"end0\": " << s.d_end0
-        << ", \"end1\": " << s.d_end1 << ", \"dogboning\": " << dog << "}";
+      e["balloon_outer_diameter"] = {{"mid", s.d_mid}, {"end0", s.d_end0}, {"end1", s.d_end1}, {"dogboning", dog}};
     }
-    j << ", \"newton_iterations\": " << s.newton_iterations << ", \"residual\": " << s.residual
-      << ", \"wall_seconds\": " << s.solve_seconds << "}" << (i + 1 < history_.size() ? "," : "") << "\n";
+    if (!s.lumen_diameter.empty()) {
+      e["lumen_diameter"] = s.lumen_diameter;
+      const auto [lo, hi] = std::minmax_element(s.lumen_diameter.begin(), s.lumen_diameter.end());
+      e["lumen_diameter_min"] = *lo;
+      e["lumen_diameter_max"] = *hi;
+    }
+    for (const auto& [name, f] : s.artery_contact_force) e["artery_contact_force"][name] = f;
+    if (s.apposition) {
+      const auto& a = *s.apposition;
+      e["apposition"] = {{"stent_length", a.length},
+                         {"malapposed_length", a.malapposed_length},
+                         {"malapposed_fraction", a.malapposed_fraction},
+                         {"max_gap", finite(a.max_gap)},
+                         {"mean_gap", finite(a.mean_gap)}};
+    }
+    e["newton_iterations"] = s.newton_iterations;
+    e["residual"] = s.residual;
+    e["wall_seconds"] = s.solve_seconds;
+    j["steps"].push_back(std::move(e));
   }
-  j << "  ]\n}\n";
   const std::string tmp = dir_ + "/summary.json.tmp";
   {
     std::ofstream f(tmp);
-    f << j.str();
+    f << j.dump(1) << "\n";
   }
   std::rename(tmp.c_str(), (dir_ + "/summary.json").c_str());
 }

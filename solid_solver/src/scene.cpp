@@ -20,7 +20,13 @@ LayerMaterial read_material(const Node& n, const std::string& name) {
   m.matrix.E = n.positive("E");
   m.matrix.nu = n.number_or("nu", 0.0);
   if (!(m.matrix.nu >= 0.0 && m.matrix.nu < 0.5)) n.child("nu").fail("a Poisson's ratio in [0, 0.5)");
-  if (n.has("viscous")) n.child("viscous").fail("no 'viscous' entry (the viscous branch is not implemented yet)");
+  if (auto v = n.optional("viscous")) {  // paper eqs. B.5–B.8: Q' + Q/tau = beta S'
+    v->check_keys({"tau", "beta"});
+    ViscousBranch vb;
+    vb.tau = v->positive("tau");
+    vb.beta = v->non_negative("beta");
+    m.viscous = vb;
+  }
   if (auto f = n.optional("fibers")) {
     if (!f->is_sequence()) f->fail("a list of fiber families {k1, k2, angle, pair, tension_only}");
     for (size_t i = 0; i < f->size(); ++i) {
@@ -184,19 +190,8 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
 
 PressureSpec read_pressure(const Node& parent, const std::string& key, const std::string& surface,
                            const scene::LoadCurves& curves, const std::string& label) {
-  const Node n = parent.child(key);
-  PressureSpec p;
-  p.surface = surface;
-  p.label = label;
-  if (n.is_scalar()) {
-    p.value = n.as_number();
-    p.curve = scene::LoadCurve::constant(1.0);
-  } else {
-    n.check_keys({"value", "curve"});
-    p.value = n.number_or("value", 1.0);
-    p.curve = scene::curve_ref(n, "curve", curves);
-  }
-  return p;
+  const scene::ScaledCurve c = scene::scaled_curve(parent, key, curves);
+  return PressureSpec{surface, c.value, c.curve, label};
 }
 
 // fixed: [{surface: end0, components: [x, y, z]}, ...]  (surface names without the part prefix)
@@ -287,7 +282,7 @@ SolidScene read_solid_scene(const Node& root) {
 
   if (auto a = root.optional("artery")) {
     sc.has_artery = true;
-    a->check_keys({"mesh", "layers", "blood_pressure", "end_springs", "fixed"});
+    a->check_keys({"mesh", "layers", "blood_pressure", "end_springs", "fixed", "summary"});
     Axis axis;
     std::vector<std::string> req;
     double length = 0;
@@ -312,6 +307,20 @@ SolidScene read_solid_scene(const Node& root) {
       }
     }
     read_fixed(*a, "artery_", m, sc.fixed);
+    if (m.surface("artery_inner")) {
+      DiameterSpec d;
+      d.node_set = "artery_inner";
+      d.axis = axis;
+      d.centerline = curved;
+      sc.lumen = d;
+    }
+    if (auto s = a->optional("summary")) {
+      s->check_keys({"apposition_threshold", "lumen_stations"});
+      sc.apposition_threshold = s->non_negative_or("apposition_threshold", sc.apposition_threshold);
+      const long n = s->integer_or("lumen_stations", sc.lumen_max_stations, 2);
+      if (n > 10000) s->child("lumen_stations").fail("at most 10000 lumen stations");
+      sc.lumen_max_stations = int(n);
+    }
     sc.mesh.append(m);
   }
   if (!sc.has_balloon && !sc.has_artery) root.fail("a scene with a 'balloon:' and/or 'artery:' section for the solid solver");

@@ -182,6 +182,20 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   }
 }
 
+void PenaltyStentContact::gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
+                               std::vector<double>& weight) {
+  gap.clear();
+  weight.clear();
+  const auto it = std::find(names_.begin(), names_.end(), surface);
+  if (it == names_.end() || points_.empty()) return;
+  const auto per_surface = evaluate_(model, points_, false);  // every rank: identical data, no communication
+  const auto& pcs = per_surface[it - names_.begin()].per_surface[0];
+  for (size_t i = 0; i < points_.size(); ++i) {
+    gap.push_back(pcs[i].found ? pcs[i].gap : std::numeric_limits<double>::infinity());
+    weight.push_back(points_[i].w);
+  }
+}
+
 // ------------------------------------------------------------------------------------------------
 // Balloon-artery surface-to-surface contact
 
@@ -245,6 +259,14 @@ void CompositeContact::add(const SolidModel& model, Vec r, Mat K) {
 void CompositeContact::fill_reply(const SolidModel& model, participant::ContactReply& reply) {
   if (stent_) stent_->fill_reply(model, reply);
   if (after_reply) after_reply(model, reply);
+}
+
+void CompositeContact::gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
+                            std::vector<double>& weight) {
+  if (stent_)
+    stent_->gaps(model, surface, gap, weight);
+  else
+    StentContact::gaps(model, surface, gap, weight);
 }
 
 }  // namespace angio::solid

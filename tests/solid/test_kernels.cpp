@@ -8,6 +8,7 @@
 #include "angio/solid/elements.hpp"
 #include "angio/solid/materials.hpp"
 #include "angio/solid/mesh.hpp"
+#include "fd_tangent.hpp"
 
 using namespace angio::solid;
 
@@ -187,19 +188,11 @@ TEST(Elements, InternalForceTangentMatchesFiniteDifferences) {
     Eigen::MatrixXd u(X.rows(), 3);
     for (int i = 0; i < u.size(); ++i) u.data()[i] = U(rng);
     for (int a = 0; a < X.rows(); ++a) u(a, 0) += 0.3 * X(a, 0);  // stretch fibers
-    Eigen::VectorXd f, fp, fm;
+    Eigen::VectorXd f;
     Eigen::MatrixXd K;
     ASSERT_TRUE(element_internal(t, X, u, adv.matrix, fibers, f, &K));
-    const double h = 1e-6;
-    Eigen::MatrixXd Kfd(K.rows(), K.cols());
-    for (int j = 0; j < K.cols(); ++j) {
-      Eigen::MatrixXd up = u, um = u;
-      up(j / 3, j % 3) += h;
-      um(j / 3, j % 3) -= h;
-      element_internal(t, X, up, adv.matrix, fibers, fp, nullptr);
-      element_internal(t, X, um, adv.matrix, fibers, fm, nullptr);
-      Kfd.col(j) = (fp - fm) / (2 * h);
-    }
+    const Eigen::MatrixXd Kfd = angio_test::fd_tangent(
+        u, [&](const Eigen::MatrixXd& v, Eigen::VectorXd& fv) { element_internal(t, X, v, adv.matrix, fibers, fv, nullptr); });
     EXPECT_LT((K - Kfd).norm(), 1e-6 * K.norm()) << name(t);
     EXPECT_LT((K - K.transpose()).norm(), 1e-10 * K.norm()) << name(t);
   }

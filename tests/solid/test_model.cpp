@@ -168,6 +168,64 @@ TEST(Model, DampingConvergesToTheEquilibrium) {
   EXPECT_EQ(f0[0], 0.0);   // off by default
 }
 
+// Viscous branch (eqs. B.5–B.8) through the model (commit/rollback of the history), consistency
+// properties under a constant follower pressure on the cube: (1) a step of vanishing Δt answers
+// with S = (1 + β) S∞, i.e. exactly the elastic solution of the material with E and k1 scaled by
+// 1 + β; (2) held at that load the cube creeps monotonically and converges to the elastic
+// equilibrium of S∞ alone (Q relaxes to 0); (3) a rejected step (rollback) leaves the history
+// untouched: the same step solved again gives the same displacement.
+TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
+  const double p = 0.05, beta = 0.3;
+  const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
+  auto disp = [&](SolidModel& model) {
+    std::vector<Vec3d> u;
+    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model.displacement(int(n)));
+    return u;
+  };
+  auto max_diff = [](const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+    double d = 0.0;
+    for (size_t n = 0; n < a.size(); ++n) d = std::max(d, (a[n] - b[n]).norm());
+    return d;
+  };
+  auto elastic = [&](double scale) {
+    auto model = pressed_cube(m, LayerMaterial{"cube", {2.0 * scale, 0.3}, {{0.4 * scale, 1.5, 20.0, true}}},
+                              direct_options(), p);
+    EXPECT_TRUE(model->solve().converged);
+    return disp(*model);
+  };
+  const auto u_inf = elastic(1.0), u_0 = elastic(1.0 + beta);
+  double scale = 0;
+  for (const auto& v : u_inf) scale = std::max(scale, v.norm());
+
+  LayerMaterial visc{"cube", {2.0, 0.3}, {{0.4, 1.5, 20.0, true}}, ViscousBranch{0.5, beta}};
+  auto model = pressed_cube(m, visc, direct_options(), p);
+  model->start_at(0.0);
+  model->set_time(1e-10);
+  ASSERT_TRUE(model->solve().converged);
+  EXPECT_LT(max_diff(disp(*model), u_0), 1e-8 * scale);
+  model->commit();
+
+  double t = 1e-10, previous = 0.0;
+  for (int i = 0; i < 100; ++i) {
+    t += 0.1;
+    model->set_time(t);
+    ASSERT_TRUE(model->solve().converged);
+    if (i == 3) {  // reject once and solve the same step again
+      const auto first = disp(*model);
+      model->rollback();
+      ASSERT_TRUE(model->solve().converged);
+      EXPECT_LT(max_diff(disp(*model), first), 1e-12 * scale);
+    }
+    model->commit();
+    const double d = max_diff(disp(*model), u_0);
+    EXPECT_GE(d, previous - 1e-14);  // creeps away from the instantaneous response, monotonically
+    previous = d;
+  }
+  // 10 s = 15 retardation times τ(1 + β) of the linearized model: e^(−15) ≈ 3e-7
+  EXPECT_LT(max_diff(disp(*model), u_inf), 1e-5 * scale);
+  EXPECT_GT(max_diff(u_0, u_inf), 0.1 * scale);  // the two limits are far apart
+}
+
 // Thick-walled cylinder, plane strain, small internal pressure: compared with Lame's linear-elastic
 // solution u_r(r) = (1+nu)/E [(1-2nu) A r + B/r], A = p a^2/(b^2-a^2), B = p a^2 b^2/(b^2-a^2).
 TEST(Model, ThickCylinderMatchesLame) {

@@ -60,6 +60,19 @@ LoadCurve curve_ref(const Node& node, const std::string& key, const LoadCurves& 
   return it->second;
 }
 
+ScaledCurve scaled_curve(const Node& parent, const std::string& key, const LoadCurves& curves) {
+  const Node n = parent.child(key);
+  ScaledCurve s;
+  if (n.is_scalar()) {
+    s.value = n.as_number();
+    return s;
+  }
+  n.check_keys({"value", "curve"});
+  s.value = n.number_or("value", 1.0);
+  s.curve = curve_ref(n, "curve", curves);
+  return s;
+}
+
 TimeSettings time_settings(const Node& root) {
   TimeSettings ts;
   auto t = root.optional("time");

@@ -8,6 +8,7 @@
 
 #include "angio/contact/face.hpp"
 #include "angio/solid/materials.hpp"
+#include "angio/solid/viscous.hpp"
 
 namespace angio::solid {
 
@@ -53,6 +54,9 @@ const std::vector<LocalFace>& local_faces(ElemType t);
 //   f_a = int B_a^T S dV,  K = int B^T D B + (grad N_a . S grad N_b) I dV.
 // X, u: n x 3 (reference coordinates and displacements). K may be null (residual only).
 // Returns false if a Jacobian (reference or deformed) is non-positive.
+// visc (optional): the viscous branch of the element's material with its committed Gauss-point
+// history (viscous.hpp); S = S∞ + Q and the tangent scaled by 1 + β g. With visc->Q_out/S_out set
+// the updated history is stored there (SolidModel::commit).
 struct ElementStress {
   Mat3 cauchy_avg = Mat3::Zero();  // Gauss-point average of the Cauchy stress
   double energy = 0.0;             // int Psi dV
@@ -60,7 +64,7 @@ struct ElementStress {
 };
 bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixXd& u, const NeoHooke& mat,
                       const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
-                      ElementStress* out = nullptr);
+                      ElementStress* out = nullptr, const ViscousHistory* visc = nullptr);
 
 // Follower pressure p on a face (traction -p n da, n = normal of the face orientation, i.e.
 // outward for oriented faces): contribution to the residual r = f_int - f_ext is

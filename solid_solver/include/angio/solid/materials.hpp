@@ -3,6 +3,7 @@
 // Voigt vectors use engineering shear (2 E12), so that dS_voigt = D dE_voigt with D = 2 dS/dC.
 #pragma once
 #include <Eigen/Dense>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,11 +58,18 @@ struct FiberSpec {
   bool tension_only = true;
 };
 
-// A layer / block material: Neo-Hooke ground matrix plus fiber families.
+// Parameters of the viscous branch of a layer (paper eqs. B.5–B.8; kernel in viscous.hpp).
+struct ViscousBranch {
+  double tau = 0.5;   // relaxation time (s), > 0
+  double beta = 0.3;  // ratio of the viscoelastic to the hyperelastic branch, ≥ 0
+};
+
+// A layer / block material: Neo-Hooke ground matrix plus fiber families, optionally a viscous branch.
 struct LayerMaterial {
   std::string name;
   NeoHooke matrix;
   std::vector<FiberSpec> fibers;
+  std::optional<ViscousBranch> viscous = std::nullopt;  // none: purely hyperelastic
 };
 
 // Local material frame of an element.

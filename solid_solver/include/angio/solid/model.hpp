@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "angio/solid/mesh.hpp"
+#include "angio/solid/viscous.hpp"
 
 namespace angio::solid {
 
@@ -99,13 +100,15 @@ class SolidModel {
   double time() const { return time_; }
   // Start (or restart) the pseudo-time at t with the current state committed there.
   void start_at(double t) {
-    time_ = t;
+    time_ = committed_time_ = t;  // no time passes: the viscous history takes only the instantaneous response
     commit();
   }
   // Newton solve at the current time (collective). Never throws for non-convergence.
   SolveReport solve();
-  void commit();    // current state becomes the committed state
-  void rollback();  // back to the last committed state
+  // Current state becomes the committed state; the viscous history (Q, S∞ per Gauss point) is
+  // advanced over Δt = t − t_committed from the committed one.
+  void commit();
+  void rollback();  // back to the last committed state (displacement; the viscous history is only ever committed)
 
   // --- access (all ranks hold the full displacement)
   MPI_Comm comm() const { return comm_; }
@@ -126,7 +129,11 @@ class SolidModel {
   void set_displacement(const std::vector<Vec3d>& u);  // by original node index (same on all ranks)
   // Per local element (order of local_elements()): first principal Cauchy stress (Gauss-point
   // averaged Cauchy tensor) and its unit direction.
-  void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir) const;
+  // volume (optional): reference volume of each local element.
+  void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume = nullptr) const;
+  // Nodal forces that contact model c exerts on the solid at the current state (−its residual
+  // contribution), full vector by original node index on every rank. Collective.
+  std::vector<Vec3d> contact_forces(ContactModel& c);
   // Assemble residual (and tangent) at the current state; for tests. Returns false on invalid state.
   bool assemble(Vec r, Mat K);
   Mat matrix() const { return K_; }
@@ -161,6 +168,15 @@ class SolidModel {
   Vec damping_diag_ = nullptr;            // η·V_a per owned dof (NewtonOptions::damping); null when off
   Vec damping_tangent_ = nullptr;         // η·V_a/Δt, refilled per assembly (no allocation in Newton)
   double damping_(Vec r, Mat K);
+  // Viscous branch (eqs. B.5–B.8): committed history per Gauss point of the local elements whose
+  // material has one; visc_offset_[i] indexes local element i's first Gauss point (−1: none).
+  std::vector<int> visc_offset_;
+  std::vector<Vec6> visc_Q_, visc_S_;
+  // Committed history of local element i over the step to the current time, filled into h (nullptr if
+  // its material has no viscous branch).
+  const ViscousHistory* viscous_history_(size_t i, ViscousHistory& h) const;
+  // Reference coordinates and current displacements of element e's nodes (rows).
+  void element_state_(int e, Eigen::MatrixXd& X, Eigen::MatrixXd& u) const;
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;

@@ -11,6 +11,8 @@
 //     /steps/<k>/<type>/stress_p1      [E]   first principal Cauchy stress (MPa), per element:
 //                                              eigenvalue of the Gauss-point averaged Cauchy tensor
 //     /steps/<k>/<type>/stress_p1_dir  [E,3] its unit eigenvector
+//     /steps/<k>/<name>            [N]    extra nodal scalars, e.g. contact_pressure (MPa): |contact
+//                                         force| / lumped nodal area on the endothelium
 //   <dir>/solid.xdmf  (rewritten after every step; open in ParaView with the Xdmf3 reader)
 #pragma once
 #include <hdf5.h>
@@ -27,7 +29,9 @@ class FieldWriter {
   FieldWriter(const SolidModel& model, const std::string& dir);  // collective
   ~FieldWriter();
   // Collective. p1/dir: per local element (model.local_elements() order), from element_stress().
-  void write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir);
+  // nodal: extra nodal scalar fields, each a full vector by original node index (same on all ranks).
+  void write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir,
+                  const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal = {});
   void close();
 
  private:
@@ -41,7 +45,12 @@ class FieldWriter {
     std::vector<int> local;  // indices into model.local_elements()
   };
   std::vector<TypeInfo> types_;
-  std::vector<std::pair<int, double>> steps_;
+  struct StepInfo {
+    int step;
+    double time;
+    std::vector<std::string> nodal;  // names of the extra nodal fields of this step
+  };
+  std::vector<StepInfo> steps_;
 };
 
 // Creates a directory and its parents (like mkdir -p); throws on failure.

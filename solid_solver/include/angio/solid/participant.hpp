@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "angio/participant/solid_participant.hpp"
+#include "angio/solid/artery_measures.hpp"
 #include "angio/solid/output.hpp"
 #include "angio/solid/scene.hpp"
 
@@ -22,11 +23,28 @@ class StentContact : public ContactModel {
  public:
   virtual void set_points(const participant::SamplePoints& points) = 0;
   virtual void fill_reply(const SolidModel& model, participant::ContactReply& reply) = 0;
+  // Gap of every sample point of set_points() to the surface set `surface` at the current state
+  // (mm, g = (x − s)·n − R; +∞ where no face lies within the search radius), and the points'
+  // arc-length weights; both empty if this contact does not involve that surface. Every rank.
+  virtual void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
+                    std::vector<double>& weight) {
+    (void)model, (void)surface;
+    gap.clear();
+    weight.clear();
+  }
 };
 
 // A contact-free reply for `points` (zero line loads, surface points = the points, inactive); SolidRunner::solve
 // starts every reply with it before the stent contact fills it.
 void reset_reply(const participant::SamplePoints& points, participant::ContactReply& reply);
+
+// First principal Cauchy stress of one block (layer) at one step (per element: the eigenvalue of
+// the Gauss-point averaged Cauchy tensor).
+struct BlockStress {
+  double max = 0.0;              // MPa
+  Vec3d where = Vec3d::Zero();   // current centroid of the element with the maximum
+  double p99 = 0.0;              // 99th percentile by reference volume (MPa), robust against one element at a strut
+};
 
 // Per committed step summary (written to <run-dir>/solid/summary.json).
 struct StepSummary {
@@ -34,6 +52,11 @@ struct StepSummary {
   double time = 0.0;
   std::vector<std::pair<std::string, double>> pressures;  // label, MPa
   std::vector<double> max_p1;                              // per block (MPa)
+  std::vector<BlockStress> stress;                         // per block
+  std::vector<std::pair<std::string, double>> max_displacement;  // per part (mm)
+  std::vector<double> lumen_diameter;                      // per lumen station (mm)
+  std::vector<std::pair<std::string, double>> artery_contact_force;  // per contact: Σ |nodal force| on the endothelium (N)
+  std::optional<Apposition> apposition;                    // stent vs endothelium
   double d_mid = 0.0, d_end0 = 0.0, d_end1 = 0.0;          // balloon outer diameter (mm)
   int newton_iterations = 0;
   double residual = 0.0;
@@ -58,6 +81,9 @@ class SolidRunner : public participant::SolidParticipant {
     stent_contact_ = contact;
     model_->set_contact(contact);
   }
+  // A contact model whose force on the endothelium is reported per step under `name` (not owned).
+  void add_contact_report(const std::string& name, ContactModel* model) { contact_reports_.emplace_back(name, model); }
+  void clear_contact_reports() { contact_reports_.clear(); }
   const std::vector<StepSummary>& history() const { return history_; }
   const SolveReport& last_report() const { return last_; }
   // Balloon outer diameters (mm) at mid-length and both ends for the current state (all ranks).
@@ -82,6 +108,13 @@ class SolidRunner : public participant::SolidParticipant {
   StentContact* stent_contact_ = nullptr;
   bool finished_ = false;
   std::vector<int> ring_mid_, ring_end0_, ring_end1_;
+  // artery outputs (empty without an artery)
+  LumenProfile lumen_;
+  std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner (by node)
+  std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
+  void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
+  void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
+  void write_apposition_csv_(const std::vector<double>& gap, const std::vector<double>& weight) const;
 };
 
 // Rank-0 side of the coupled mode: broadcasts each call to the followers, then runs it.

@@ -48,6 +48,11 @@ struct SolidScene {
   std::vector<SpringSpec> springs;
   std::vector<FixedSpec> fixed;
   std::optional<DiameterSpec> balloon_diameter;
+  // Artery summary (artery.summary): lumen stations along the vessel axis (artery_inner nodes) and the
+  // apposition threshold (a strut farther than this from the endothelium is malapposed).
+  std::optional<DiameterSpec> lumen;  // node_set: "artery_inner"
+  int lumen_max_stations = 100;
+  double apposition_threshold = 0.1;  // mm
   bool has_balloon = false, has_artery = false;
   int ranks = 0;  // solid.ranks (0: not given)
   int output_every = 1;

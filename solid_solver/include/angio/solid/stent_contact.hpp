@@ -68,6 +68,8 @@ class PenaltyStentContact : public StentContact {
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
+  void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
+            std::vector<double>& weight) override;
 
   int num_surfaces() const { return int(surfaces_.size()); }
   const std::vector<std::string>& surface_names() const { return names_; }
@@ -128,6 +130,8 @@ class CompositeContact : public StentContact {
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
+  void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
+            std::vector<double>& weight) override;
   // Called on every rank after each converged solve's reply (e.g. logging of the contact diagnostics).
   std::function<void(const SolidModel&, const participant::ContactReply&)> after_reply;
 

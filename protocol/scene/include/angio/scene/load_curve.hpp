@@ -34,6 +34,15 @@ LoadCurves load_curves(const Node& root);
 // Absent key → constant 1 (a load without a curve is applied fully at every time).
 LoadCurve curve_ref(const Node& node, const std::string& key, const LoadCurves& curves);
 
+// A load given as a plain number (constant) or as {value, curve}: value × curve(t).
+struct ScaledCurve {
+  double value = 0.0;
+  LoadCurve curve = LoadCurve::constant(1.0);
+  double at(double t) const { return value * curve.value(t); }
+};
+// Reads `key` of `parent` in either form (the value of {value, curve} defaults to 1).
+ScaledCurve scaled_curve(const Node& parent, const std::string& key, const LoadCurves& curves);
+
 // The `time:` section: pseudo-time interval and load steps, shared by all participants.
 struct TimeSettings {
   double start = 0.0;

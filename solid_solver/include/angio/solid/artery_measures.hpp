@@ -1,0 +1,52 @@
+// What a user reads from an artery (pure functions, no MPI): volume-weighted stress percentiles per
+// layer, the lumen diameter profile along the vessel, and stent apposition. Units: mm, MPa.
+#pragma once
+#include <limits>
+#include <vector>
+
+#include "angio/solid/mesh.hpp"
+
+namespace angio::solid {
+
+// The q-quantile (0 < q ≤ 1) of `values` weighted by `weights` (e.g. element volumes): the smallest
+// value v such that the values ≤ v carry at least q of the total weight. Unlike the maximum, which sits
+// at one element next to a strut and changes with the mesh, it converges under refinement.
+// Empty input: NaN.
+double weighted_quantile(std::vector<double> values, std::vector<double> weights, double q);
+
+// Lumen diameter along the vessel: the endothelium nodes grouped into axial stations (the rings of
+// a structured tube, or `max_stations` equal bins of an unstructured mesh), the diameter of a station
+// being 2 × the mean distance of its nodes from their centroid in the current configuration (the
+// centroid follows a vessel that moves or bends).
+class LumenProfile {
+ public:
+  LumenProfile() = default;
+  // nodes: endothelium nodes; station: their reference axial coordinate (arc length).
+  LumenProfile(const std::vector<int>& nodes, const std::vector<double>& station, int max_stations);
+  const std::vector<double>& stations() const { return s_; }  // mean reference station of each group (mm)
+  // x: current positions of all mesh nodes (indexed by mesh node).
+  std::vector<double> diameters(const std::vector<Vec3d>& x) const;
+  bool empty() const { return groups_.empty(); }
+
+ private:
+  std::vector<double> s_;
+  std::vector<std::vector<int>> groups_;
+};
+
+// Apposition of the stent: gap per strut sample point (distance from the strut surface to the
+// endothelium, g = (x − s)·n − R; negative: embedded; +∞: no endothelium within the search radius)
+// with its arc-length weight.
+struct Apposition {
+  double length = 0.0;               // stent centerline length (mm), Σ w
+  double malapposed_length = 0.0;    // Σ w over points with g > threshold (or no wall in range)
+  double malapposed_fraction = 0.0;  // malapposed_length / length
+  double max_gap = -std::numeric_limits<double>::infinity();  // largest finite gap (mm)
+  double mean_gap = 0.0;             // length-weighted mean of the finite gaps (mm)
+};
+Apposition apposition(const std::vector<double>& gap, const std::vector<double>& weight, double threshold);
+
+// Lumped nodal area of a surface set (reference configuration): each face's area shared equally by
+// its nodes. Returns a vector indexed by mesh node (0 off the surface).
+std::vector<double> nodal_areas(const Mesh& mesh, const SurfaceSet& surface);
+
+}  // namespace angio::solid

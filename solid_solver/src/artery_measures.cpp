@@ -1,0 +1,98 @@
+#include "angio/solid/artery_measures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace angio::solid {
+
+double weighted_quantile(std::vector<double> values, std::vector<double> weights, double q) {
+  if (values.size() != weights.size()) throw std::invalid_argument("weighted_quantile: sizes differ");
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<size_t> order(values.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return values[a] < values[b]; });
+  const double total = std::accumulate(weights.begin(), weights.end(), 0.0);
+  double cum = 0.0;
+  for (size_t i : order) {
+    cum += weights[i];
+    if (cum >= q * total * (1.0 - 1e-12)) return values[i];
+  }
+  return values[order.back()];
+}
+
+LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<double>& station, int max_stations) {
+  if (nodes.empty()) return;
+  const auto [lo, hi] = std::minmax_element(station.begin(), station.end());
+  const double smin = *lo, smax = *hi, tol = 1e-6 * std::max(1.0, smax - smin);
+  std::vector<double> distinct(station);
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end(), [&](double a, double b) { return b - a <= tol; }),
+                 distinct.end());
+  const bool rings = int(distinct.size()) <= max_stations;
+  const int n = rings ? int(distinct.size()) : max_stations;
+  groups_.assign(n, {});
+  std::vector<double> sum(n, 0.0);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    int k;
+    if (rings) {
+      k = int(std::lower_bound(distinct.begin(), distinct.end(), station[i] - tol) - distinct.begin());
+    } else {
+      k = std::min(n - 1, int((station[i] - smin) / (smax - smin) * n));
+    }
+    groups_[k].push_back(nodes[i]);
+    sum[k] += station[i];
+  }
+  for (int k = 0; k < n; ++k)
+    if (!groups_[k].empty()) {
+      s_.push_back(sum[k] / double(groups_[k].size()));
+    }
+  groups_.erase(std::remove_if(groups_.begin(), groups_.end(), [](const auto& g) { return g.empty(); }),
+                groups_.end());
+}
+
+std::vector<double> LumenProfile::diameters(const std::vector<Vec3d>& x) const {
+  std::vector<double> d(groups_.size(), 0.0);
+  for (size_t k = 0; k < groups_.size(); ++k) {
+    Vec3d c = Vec3d::Zero();
+    for (int n : groups_[k]) c += x[n];
+    c /= double(groups_[k].size());
+    double r = 0.0;
+    for (int n : groups_[k]) r += (x[n] - c).norm();
+    d[k] = 2.0 * r / double(groups_[k].size());
+  }
+  return d;
+}
+
+Apposition apposition(const std::vector<double>& gap, const std::vector<double>& weight, double threshold) {
+  if (gap.size() != weight.size()) throw std::invalid_argument("apposition: sizes differ");
+  Apposition a;
+  double finite_len = 0.0, gap_sum = 0.0;
+  for (size_t i = 0; i < gap.size(); ++i) {
+    a.length += weight[i];
+    if (!(gap[i] <= threshold)) a.malapposed_length += weight[i];  // also +∞: no wall in range
+    if (std::isfinite(gap[i])) {
+      finite_len += weight[i];
+      gap_sum += weight[i] * gap[i];
+      a.max_gap = std::max(a.max_gap, gap[i]);
+    }
+  }
+  a.malapposed_fraction = a.length > 0 ? a.malapposed_length / a.length : 0.0;
+  a.mean_gap = finite_len > 0 ? gap_sum / finite_len : std::numeric_limits<double>::quiet_NaN();
+  return a;
+}
+
+std::vector<double> nodal_areas(const Mesh& mesh, const SurfaceSet& surface) {
+  std::vector<double> area(mesh.X.size(), 0.0);
+  Eigen::MatrixXd X;
+  for (const auto& f : surface.faces) {
+    X.resize(f.nn(), 3);
+    for (int a = 0; a < f.nn(); ++a) X.row(a) = mesh.X[f.n[a]].transpose();
+    const double A = face_area_vector(f.type, X).norm();
+    for (int a = 0; a < f.nn(); ++a) area[f.n[a]] += A / f.nn();
+  }
+  return area;
+}
+
+}  // namespace angio::solid

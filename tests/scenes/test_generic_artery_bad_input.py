@@ -1,0 +1,50 @@
+#!/usr/bin/python3
+"""Bad input in the generic artery scene's keys is refused through the launcher: exit code 2 and a
+message naming the file and the key path (README "Scenes"). One case per new key of the artery
+procedure: viscous tau <= 0, beta < 0, apposition threshold < 0, a layer without a material,
+an unknown key in the viscous branch, too many lumen stations.
+Usage: test_generic_artery_bad_input.py BIN_DIR
+"""
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENE = ROOT / "configs" / "generic_artery.yaml"
+failures = []
+
+
+def media(s):
+    return s["artery"]["layers"]["media"]
+
+
+CASES = [
+    ("viscous tau = 0", lambda s: media(s)["viscous"].update(tau=0.0), "artery.layers.media.viscous.tau"),
+    ("viscous beta < 0", lambda s: media(s)["viscous"].update(beta=-0.1), "artery.layers.media.viscous.beta"),
+    ("viscous typo", lambda s: media(s)["viscous"].update(taus=0.5), "artery.layers.media.viscous"),
+    ("apposition threshold < 0", lambda s: s["artery"].update(summary={"apposition_threshold": -0.1}),
+     "artery.summary.apposition_threshold"),
+    ("lumen stations huge", lambda s: s["artery"].update(summary={"lumen_stations": 10 ** 9}),
+     "artery.summary.lumen_stations"),
+    ("layer without material", lambda s: s["artery"]["layers"].pop("adventitia"), "artery.layers"),
+]
+
+with tempfile.TemporaryDirectory() as tmp:
+    for name, edit, key in CASES:
+        s = yaml.safe_load(SCENE.read_text())
+        edit(s)
+        scene = Path(tmp) / "bad.yaml"
+        scene.write_text(yaml.safe_dump(s, sort_keys=False))
+        r = subprocess.run([sys.executable, str(ROOT / "scripts" / "launch.py"), str(scene), "--run-dir",
+                            str(Path(tmp) / name.replace(" ", "_")), "--build-dir", str(Path(sys.argv[1]).parent)],
+                           capture_output=True, text=True, timeout=120)
+        out = r.stdout + r.stderr
+        ok = r.returncode == 2 and f"{scene}: {key}" in out and "Traceback" not in out
+        print(("ok   " if ok else "FAIL ") + f"{name}: exit {r.returncode}, names '{key}'", flush=True)
+        if not ok:
+            print(out[-1500:])
+            failures.append(name)
+sys.exit(1 if failures else 0)

@@ -1,0 +1,95 @@
+// Measures a user reads from an artery (artery_measures.hpp), against exact values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "angio/solid/artery_measures.hpp"
+
+using namespace angio::solid;
+
+// Exact: the volume-weighted quantile is the value at which the cumulative weight first reaches q.
+TEST(ArteryMeasures, WeightedQuantile) {
+  // values 1..100 with equal weights: the 99 % quantile is 99, the median 50
+  std::vector<double> v, w;
+  for (int i = 100; i >= 1; --i) {
+    v.push_back(i);
+    w.push_back(1.0);
+  }
+  EXPECT_EQ(weighted_quantile(v, w, 0.99), 99.0);
+  EXPECT_EQ(weighted_quantile(v, w, 0.5), 50.0);
+  EXPECT_EQ(weighted_quantile(v, w, 1.0), 100.0);
+  // one huge value in a tiny element does not move the 99 % quantile (the reason to report it)
+  v = {1.0, 2.0, 1000.0};
+  w = {50.0, 49.5, 0.5};
+  EXPECT_EQ(weighted_quantile(v, w, 0.99), 2.0);
+  EXPECT_TRUE(std::isnan(weighted_quantile({}, {}, 0.99)));
+}
+
+// Exact: the endothelium nodes of a generated tube lie on circles, so every station measures 2 r_i;
+// a rigid translation changes nothing, and a radial scaling of one ring changes only its station.
+TEST(ArteryMeasures, LumenProfileOfATube) {
+  TubeSpec t;
+  t.part = "artery";
+  t.surface_prefix = "artery_";
+  t.length = 4.0;
+  t.inner_radius = 0.8;
+  t.layers = {{"media", 0.3, 1}};
+  t.n_circ = 16;
+  t.n_axial = 8;
+  Mesh m = make_tube(t);
+  const SurfaceSet* endo = m.surface("artery_inner");
+  ASSERT_NE(endo, nullptr);
+  std::vector<int> nodes;
+  for (const auto& f : endo->faces)
+    for (int a = 0; a < f.nn(); ++a) nodes.push_back(f.n[a]);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  std::vector<double> s;
+  for (int n : nodes) s.push_back(m.X[n](2));
+  const LumenProfile lp(nodes, s, 100);
+  ASSERT_EQ(lp.stations().size(), 9u);  // the rings of the structured tube
+  std::vector<Vec3d> x = m.X;
+  for (double d : lp.diameters(x)) EXPECT_NEAR(d, 1.6, 1e-12);
+  for (auto& p : x) p += Vec3d(0.3, -0.2, 1.0);
+  for (double d : lp.diameters(x)) EXPECT_NEAR(d, 1.6, 1e-12);
+  x = m.X;
+  for (int n : nodes)
+    if (std::abs(m.X[n](2)) < 1e-9) x[n].head<2>() *= 1.25;  // the middle station (z = 0)
+  const auto d = lp.diameters(x);
+  for (size_t k = 0; k < d.size(); ++k)
+    EXPECT_NEAR(d[k], std::abs(lp.stations()[k]) < 1e-9 ? 2.0 : 1.6, 1e-12) << "station " << lp.stations()[k];
+  // fewer allowed stations than rings: equal bins
+  const LumenProfile coarse(nodes, s, 4);
+  EXPECT_EQ(coarse.stations().size(), 4u);
+}
+
+// Exact: fractions of a weighted set of gaps; +∞ (no wall within the search radius) is malapposed.
+TEST(ArteryMeasures, Apposition) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto a = apposition({-0.01, 0.05, 0.2, inf}, {1.0, 1.0, 2.0, 1.0}, 0.1);
+  EXPECT_DOUBLE_EQ(a.length, 5.0);
+  EXPECT_DOUBLE_EQ(a.malapposed_length, 3.0);
+  EXPECT_DOUBLE_EQ(a.malapposed_fraction, 0.6);
+  EXPECT_DOUBLE_EQ(a.max_gap, 0.2);
+  EXPECT_DOUBLE_EQ(a.mean_gap, (-0.01 + 0.05 + 0.4) / 4.0);
+}
+
+// Exact: lumped nodal areas of a surface add up to its area (flat faces of the tube's end ring).
+TEST(ArteryMeasures, NodalAreasSumToTheSurfaceArea) {
+  TubeSpec t;
+  t.part = "artery";
+  t.surface_prefix = "artery_";
+  t.length = 2.0;
+  t.inner_radius = 0.8;
+  t.layers = {{"media", 0.3, 2}};
+  t.n_circ = 12;
+  t.n_axial = 2;
+  const Mesh m = make_tube(t);
+  const auto area = nodal_areas(m, *m.surface("artery_end0"));
+  double sum = 0.0;
+  for (double a : area) sum += a;
+  // the end face is a ring of 12 plane trapezoids between r = 0.8 and 1.1: area 12 sin(π/12)cos(π/12)(1.1² − 0.8²)
+  const double exact = 12.0 * std::sin(std::numbers::pi / 12) * std::cos(std::numbers::pi / 12) * (1.1 * 1.1 - 0.8 * 0.8);
+  EXPECT_NEAR(sum, exact, 1e-12);
+}
