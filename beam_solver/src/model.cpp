@@ -4,6 +4,7 @@
 #include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
 #include "angio/participant/plane_penalty.hpp"
+#include "angio/participant/types.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -204,16 +205,20 @@ void BeamModel::set_sample_line_loads(const std::vector<Vec3>& q) {
   q_ext_ = q;
 }
 void BeamModel::set_sample_planes(std::vector<SamplePlane> planes) {
-  if (!planes.empty() && static_cast<int>(planes.size()) != num_sample_points())
-    throw std::invalid_argument("expected " + std::to_string(num_sample_points()) +
+  const std::size_t K = participant::planes_per_point(planes.size(), std::size_t(num_sample_points()));
+  if (!planes.empty() && K == 0)
+    throw std::invalid_argument("expected K x " + std::to_string(num_sample_points()) +
                                 " contact planes, got " + std::to_string(planes.size()));
   planes_ = std::move(planes);
+  planes_per_point_ = int(K);
 }
 std::vector<Vec3> BeamModel::sample_contact_loads() const {
   std::vector<Vec3> q = q_ext_;
-  for (size_t g = 0; g < planes_.size(); ++g)
-    q[g] += participant::plane_penalty(sample_position(int(g)), planes_[g].s, planes_[g].n, planes_[g].eps,
-                                      sample_radius(int(g)), planes_[g].g0).q;
+  for (size_t i = 0; i < planes_.size(); ++i) {
+    const int g = int(i) / planes_per_point_;
+    q[g] += participant::plane_penalty(sample_position(g), planes_[i].s, planes_[i].n, planes_[i].eps,
+                                      sample_radius(g), planes_[i].g0).q;
+  }
   return q;
 }
 std::vector<Vec3> BeamModel::sample_load_nodal_forces() const {
@@ -348,9 +353,11 @@ void BeamModel::assemble_global(SpMat* K, Eigen::VectorXd& rg) {
       const double N2 = gauss_xi_[k], N1 = 1.0 - N2;
       const double w = gauss_w_[k] * eref_[e].L0;
       Vec3 q = q_ext_[g] + elem_q_[e] + elem_p_dead_[e] * ref_radial_[g];
-      if (!planes_.empty() && planes_[g].eps > 0.0) {
-        const participant::PlanePenalty pp = participant::plane_penalty(N1 * x_[a] + N2 * x_[b], planes_[g].s, planes_[g].n,
-                                              planes_[g].eps, sections_[elem_section_[e]].contact_radius, planes_[g].g0);
+      for (int j = 0; j < planes_per_point_ && !planes_.empty(); ++j) {
+        const SamplePlane& pl = planes_[g * planes_per_point_ + j];
+        if (!(pl.eps > 0.0)) continue;
+        const participant::PlanePenalty pp = participant::plane_penalty(
+            N1 * x_[a] + N2 * x_[b], pl.s, pl.n, pl.eps, sections_[elem_section_[e]].contact_radius, pl.g0);
         q += pp.q;
         if (K) add_load_stiffness(N1, N2, w, pp.dq_dx);  // zero where the point is free
       }

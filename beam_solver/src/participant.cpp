@@ -84,10 +84,10 @@ void BeamSolverParticipant::begin_step(int step, double time) {
 participant::SolveStats BeamSolverParticipant::solve_with_planes(const std::vector<participant::Vec3>& q,
                                                                  const participant::ContactPlanes& planes) {
   BeamModel& m = *scene_.model;
-  if (static_cast<int>(planes.size()) != m.num_sample_points() || planes.s.size() != planes.size() ||
-      planes.n.size() != planes.size()) {
+  if (participant::planes_per_point(planes.size(), std::size_t(m.num_sample_points())) == 0 ||
+      planes.s.size() != planes.size() || planes.n.size() != planes.size()) {
     participant::SolveStats out;
-    out.message = "expected " + std::to_string(m.num_sample_points()) + " contact planes, got " +
+    out.message = "expected K x " + std::to_string(m.num_sample_points()) + " contact planes, got " +
                   std::to_string(planes.size());
     return out;
   }

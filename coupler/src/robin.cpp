@@ -10,11 +10,16 @@
 
 namespace angio::coupler {
 
-Robin::Robin(std::size_t n) {
-  p_.s = p_.n = Eigen::VectorXd::Zero(3 * n);
-  p_.eps = Eigen::VectorXd::Zero(n);  // no planes before the solid has answered once
-  p_tilde_ = p_last_ = p_before_ = p_;
+Robin::Robin(std::size_t n) : n_(n) {
+  set_planes_per_point_(1);
   c_ = c_tilde_ = c_last_ = Eigen::VectorXd::Zero(3 * n);
+}
+
+void Robin::set_planes_per_point_(std::size_t K) {
+  K_ = K;
+  p_.s = p_.n = Eigen::VectorXd::Zero(3 * K * n_);
+  p_.eps = Eigen::VectorXd::Zero(K * n_);  // no planes before the solid has answered once
+  p_tilde_ = p_last_ = p_before_ = p_;
 }
 
 void Robin::begin_step(double increment, bool extrapolate) {
@@ -42,11 +47,13 @@ participant::SolveStats Robin::solve_beam(participant::BeamParticipant& beam) {
 
 Eigen::VectorXd Robin::plane_loads(const participant::SamplePoints& x, const Planes& p) {
   Eigen::VectorXd q = Eigen::VectorXd::Zero(3 * x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    if (!(p.eps[i] > 0.0)) continue;
+  const std::size_t K = std::size_t(p.eps.size()) / x.size();
+  for (Eigen::Index j = 0; j < p.eps.size(); ++j) {
+    if (!(p.eps[j] > 0.0)) continue;
+    const std::size_t i = std::size_t(j) / K;
     const Eigen::Vector3d xi(x.x[i][0], x.x[i][1], x.x[i][2]);
-    q.segment<3>(3 * i) = participant::plane_penalty(xi, p.s.segment<3>(3 * i), p.n.segment<3>(3 * i),
-                                                     p.eps[i], x.radius[i], p.g0).q;
+    q.segment<3>(3 * i) += participant::plane_penalty(xi, p.s.segment<3>(3 * j), p.n.segment<3>(3 * j), p.eps[j],
+                                                      x.radius[i], p.g0).q;
   }
   return q;
 }
@@ -54,9 +61,16 @@ Eigen::VectorXd Robin::plane_loads(const participant::SamplePoints& x, const Pla
 Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x,
                                       const participant::ContactReply& reply) {
   const std::size_t n = x.size();
-  if (reply.surface_points.size() != n || reply.normals.size() != n || reply.penalty.size() != n)
-    throw std::runtime_error("robin coupling needs the solid's contact planes for all " + std::to_string(n) +
-                             " sample points, got " + std::to_string(reply.penalty.size()));
+  const std::size_t K = participant::planes_per_point(reply.penalty.size(), n);
+  if (K == 0 || reply.surface_points.size() != reply.penalty.size() || reply.normals.size() != reply.penalty.size())
+    throw std::runtime_error("robin coupling needs the solid's contact planes (K per point) for all " +
+                             std::to_string(n) + " sample points, got " + std::to_string(reply.penalty.size()));
+  if (K != K_) {
+    if (p_last_.eps.maxCoeff() > 0.0 || p_.eps.maxCoeff() > 0.0)
+      throw std::runtime_error("robin coupling: the solid changed the number of contact planes per point from " +
+                               std::to_string(K_) + " to " + std::to_string(K) + " during the run");
+    set_planes_per_point_(K);
+  }
   const Eigen::VectorXd q_tilde = flatten(reply.line_loads);
   const Eigen::VectorXd q_beam = c_ + plane_loads(x, p_);  // what the beam applied at x
   p_tilde_.s = flatten(reply.surface_points);

@@ -151,32 +151,31 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
   const auto per_surface = evaluate_(model, points_, false);  // every rank: identical data, no communication
-  for (size_t i = 0; i < n && !per_surface.empty(); ++i) {
+  if (per_surface.empty()) return;
+  // robin data: one plane per point and surface (K = number of surfaces, point-major), eps = 0 where
+  // the surface has no face within the search radius
+  const size_t K = per_surface.size();
+  reply.surface_points.assign(K * n, {0.0, 0.0, 0.0});
+  reply.normals.assign(K * n, {0.0, 0.0, 0.0});
+  reply.penalty.assign(K * n, 0.0);
+  reply.regularization = opt_.regularization;
+  for (size_t i = 0; i < n; ++i) {
     contact::Vec3 q = contact::Vec3::Zero();
-    int best = -1;
-    double best_gap = std::numeric_limits<double>::infinity();
     bool active = false;
-    for (size_t k = 0; k < per_surface.size(); ++k) {
+    for (size_t k = 0; k < K; ++k) {
       q += per_surface[k].q[i];
       const auto& pc = per_surface[k].per_surface[0][i];
+      const size_t j = i * K + k;
+      reply.surface_points[j] = {points_[i].x(0), points_[i].x(1), points_[i].x(2)};
       if (!pc.found) continue;
       active = active || pc.active;
-      if (pc.gap < best_gap) {
-        best_gap = pc.gap;
-        best = int(k);
-      }
+      reply.surface_points[j] = {pc.proj.s(0), pc.proj.s(1), pc.proj.s(2)};
+      reply.normals[j] = {pc.proj.n(0), pc.proj.n(1), pc.proj.n(2)};
+      reply.penalty[j] = penalty_[k];
+      reply.min_gap = std::min(reply.min_gap, pc.gap);
     }
     reply.line_loads[i] = {q(0), q(1), q(2)};
     for (int c = 0; c < 3; ++c) reply.total_force[c] += points_[i].w * q(c);
-    if (best >= 0) {
-      // robin data: the plane of the surface with the smallest gap (only one plane per point is representable)
-      const auto& pc = per_surface[best].per_surface[0][i];
-      reply.surface_points[i] = {pc.proj.s(0), pc.proj.s(1), pc.proj.s(2)};
-      reply.normals[i] = {pc.proj.n(0), pc.proj.n(1), pc.proj.n(2)};
-      reply.penalty[i] = penalty_[best];
-      reply.regularization = opt_.regularization;
-      reply.min_gap = std::min(reply.min_gap, best_gap);
-    }
     reply.active[i] = active ? 1 : 0;
     reply.n_active += active ? 1 : 0;
   }

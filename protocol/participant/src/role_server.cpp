@@ -115,7 +115,7 @@ int serve(BeamParticipant& beam, const ServeOptions& o) {
           throw msg::ProtocolError("BeamSolveRequest carries " + std::to_string(q.size()) +
                                    " line loads, the stent has " + std::to_string(n) +
                                    " sample points");
-        // Robin mode when the request carries contact planes (all three vectors, one per point).
+        // Robin mode when the request carries contact planes (all three vectors, K per point).
         ContactPlanes planes;
         planes.s = msg::to_vec3s(r.surface_points());
         planes.n = msg::to_vec3s(r.normals());
@@ -123,10 +123,11 @@ int serve(BeamParticipant& beam, const ServeOptions& o) {
         planes.g0 = r.regularization();
         const bool robin = !planes.eps.empty();
         if ((robin || !planes.s.empty() || !planes.n.empty()) &&
-            (planes.s.size() != n || planes.n.size() != n || planes.eps.size() != n))
+            (planes_per_point(planes.eps.size(), n) == 0 || planes.s.size() != planes.eps.size() ||
+             planes.n.size() != planes.eps.size()))
           throw msg::ProtocolError("BeamSolveRequest carries contact planes of sizes " +
                                    std::to_string(planes.s.size()) + "/" + std::to_string(planes.n.size()) +
-                                   "/" + std::to_string(planes.eps.size()) + ", expected " +
+                                   "/" + std::to_string(planes.eps.size()) + ", expected K x " +
                                    std::to_string(n) + " each");
         const auto t0 = Clock::now();
         SolveStats stats = robin ? beam.solve_with_planes(q, planes) : beam.solve(q);

@@ -141,8 +141,9 @@ class BeamModel {
   double sample_weight(int g) const;
   double sample_radius(int g) const;
   void set_sample_line_loads(const std::vector<Vec3>& q);  // N/mm, one per sample point
-  // Robin mode: frozen contact planes per sample point (eps = 0: none), see plane_penalty.hpp.
-  // Their penalty loads are added to the sample line loads and linearized; empty: no planes.
+  // Robin mode: K frozen contact planes per sample point (eps = 0: none; plane j of point g at
+  // g·K + j, one per contact surface), see plane_penalty.hpp. Their penalty loads are added to the
+  // sample line loads and linearized; empty: no planes.
   struct SamplePlane {
     Vec3 s = Vec3::Zero(), n = Vec3::Zero();
     double eps = 0.0;
@@ -199,6 +200,7 @@ class BeamModel {
   std::vector<Vec6> stress_;
   std::vector<Vec3> q_ext_;
   std::vector<SamplePlane> planes_;
+  int planes_per_point_ = 0;
   std::vector<Vec3> ref_radial_;  // reference radial direction per sample point
   std::vector<char> identity_basis_;
   std::vector<int> elem_dofs_;    // per element its 12 free DOF indices (−1: fixed)

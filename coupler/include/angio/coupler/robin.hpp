@@ -3,9 +3,12 @@
 // adds their penalty law q(x) = −ε⟨(x − s)·n − R⟩n to its loads and linearizes it in its Newton
 // (participant/plane_penalty.hpp); the solid evaluates the true contact at the beam's positions
 // and returns the planes there. The acceleration acts on the plane points, moved only along the
-// normal (the tangential position of s does not change the plane). One plane per point: where a
-// point touches two surfaces (balloon and artery), the remainder q~ − q_plane(x) of the solid's
-// load is passed to the beam as a fixed line load, so the fixed point is exact in that case too.
+// normal (the tangential position of s does not change the plane). K planes per point, one per
+// contact surface (balloon and artery: a strut pressed between them sees the stiffness of both;
+// with a single plane the other surface's load would be a fixed Neumann load for the soft stent,
+// and the iteration oscillates as in plain Dirichlet–Neumann). The remainder q~ − Σ q_plane(x) of
+// the solid's load (zero when the planes represent the contact exactly) is passed to the beam as a
+// fixed line load, so the fixed point is exact in any case.
 #pragma once
 
 #include "angio/coupler/interface_scheme.hpp"
@@ -24,9 +27,12 @@ class Robin : public InterfaceScheme {
 
  private:
   struct Planes {
-    Eigen::VectorXd s, n, eps;  // 3n, 3n, n
+    Eigen::VectorXd s, n, eps;  // 3Kn, 3Kn, Kn (plane j of point i at i·K + j)
     double g0 = 0.0;            // regularization of the penalty law (mm)
   };
+  // Sets the number of planes per point from the solid's first reply (fixed for a run).
+  void set_planes_per_point_(std::size_t K);
+  std::size_t n_ = 0, K_ = 1;
   // Σ line loads of the planes at positions x (N/mm, 3 per point).
   static Eigen::VectorXd plane_loads(const participant::SamplePoints& x, const Planes& p);
   Planes p_, p_tilde_, p_last_, p_before_;

@@ -31,15 +31,22 @@ struct SolveStats {
 // Robin mode (DESIGN §2): frozen contact planes per sample point, point s (mm), unit normal n
 // toward the beam and penalty eps (N/mm²; 0: no plane at this point). The beam adds the penalty
 // law q(x) = −eps·⟨(x − s)·n − R⟩·n of each plane to its loads and linearizes it in its Newton.
+// K planes per sample point (K ≥ 1), point-major: plane j of point i at index i·K + j; a point
+// pressed between two surfaces (stent between balloon and artery) has one plane per surface.
 struct ContactPlanes {
   std::vector<Vec3> s, n;
   std::vector<double> eps;
   double g0 = 0.0;  // mm, regularization of the penalty law (plane_penalty.hpp), 0 = linear
   std::size_t size() const { return eps.size(); }
 };
+// K for `planes` planes over `points` sample points; 0 if they do not divide (a malformed message).
+inline std::size_t planes_per_point(std::size_t planes, std::size_t points) {
+  return points > 0 && planes >= points && planes % points == 0 ? planes / points : 0;
+}
 
 // Solid → beam: the contact line loads q (N/mm) acting on the beam at each sample point, and for
-// the robin mode the active surface point s, its unit normal n (toward the beam) and penalty eps.
+// the robin mode per point and contact surface (K planes per point, as ContactPlanes) the closest
+// surface point s, its unit normal n (toward the beam) and penalty eps (0: no face in range).
 struct ContactReply {
   std::vector<Vec3> line_loads;
   std::vector<Vec3> surface_points;
