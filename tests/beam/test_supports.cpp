@@ -43,6 +43,16 @@ double tangent_fd_error(BeamModel& m, const SpMat& K, int n) {
   }
   return err;
 }
+// A straight strut of n elements along x (0.5 mm each, R = 0.06 mm), clamped at node 0, at t = 1.
+void clamped_strut(BeamModel& m, int n) {
+  const int sec = m.add_section(circular_section(380000.0, 0.3, 0.06));
+  for (int i = 0; i <= n; ++i) m.add_node(Vec3(0.5 * i, 0.0, 0.0));
+  for (int i = 0; i < n; ++i) m.add_element(i, i + 1, sec, Vec3::UnitY());
+  m.fix(0, {true, true, true, true, true, true});
+  m.finalize();
+  m.set_time(1.0);
+}
+
 }  // namespace
 
 // Prescribed end rotation 2π about z (rotation vector with a load curve, 20 steps) on a
@@ -154,14 +164,8 @@ TEST(BeamSupports, AssembledTangentWithFollowerLoadMatchesFiniteDifferences) {
 // law and the linear-quadratic one (g0 > 0, points inside its quadratic zone).
 TEST(BeamSupports, AssembledTangentWithContactPlanesMatchesFiniteDifferences) {
   BeamModel m;
-  Section s = circular_section(380000.0, 0.3, 0.06);
-  const int sec = m.add_section(s);
   const int n = 4;
-  for (int i = 0; i <= n; ++i) m.add_node(Vec3(0.5 * i, 0.0, 0.0));
-  for (int i = 0; i < n; ++i) m.add_element(i, i + 1, sec, Vec3::UnitY());
-  m.fix(0, {true, true, true, true, true, true});
-  m.finalize();
-  m.set_time(1.0);
+  clamped_strut(m, n);
   std::vector<BeamModel::SamplePlane> planes(m.num_sample_points());
   int active = 0;
   for (int g = 0; g < m.num_sample_points(); ++g) {
@@ -194,14 +198,8 @@ TEST(BeamSupports, AssembledTangentWithContactPlanesMatchesFiniteDifferences) {
 // with both planes active matches finite differences.
 TEST(BeamSupports, TwoContactPlanesPerPointAddUpAndLinearize) {
   BeamModel m;
-  Section s = circular_section(380000.0, 0.3, 0.06);
-  const int sec = m.add_section(s);
   const int n = 4;
-  for (int i = 0; i <= n; ++i) m.add_node(Vec3(0.5 * i, 0.0, 0.0));
-  for (int i = 0; i < n; ++i) m.add_element(i, i + 1, sec, Vec3::UnitY());
-  m.fix(0, {true, true, true, true, true, true});
-  m.finalize();
-  m.set_time(1.0);
+  clamped_strut(m, n);
   const int ng = m.num_sample_points();
   std::vector<BeamModel::SamplePlane> planes(2 * ng);
   const Vec3 nb = Vec3(0.2, 1.0, 0.3).normalized();

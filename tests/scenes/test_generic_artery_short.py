@@ -5,9 +5,9 @@ solid ranks.
 The shipped scene with a coarser and narrower artery (32 around x 24 along x (1 + 1) hex8 instead
 of 48 x 36 x (2 + 2); outer diameter 2.5 mm, i.e. a lumen of 1.3 mm, which blood pressure widens to
 about 1.55 mm) and only the first part of the procedure: blood pressure, then the balloon up to
-t_end (default 0.48 s, 0.63 MPa). The stent meets the wall at t = 0.44 s there (in the shipped
+t_end (default 0.46 s, 0.61 MPa). The stent meets the wall at t = 0.44 s there (in the shipped
 scene only past t = 0.6 s), so CI runs blood pressure, the viscous branch, the contacts and the
-coupling into stent-artery contact in 34 steps.
+coupling into stent-artery contact in 33 steps.
 Checks:
   * the run completes every step (status ok, all committed), the run directory is complete;
   * stent-artery contact is active at the end (force on the endothelium > 0, struts apposed),
@@ -15,7 +15,7 @@ Checks:
     (tension in the media and adventitia under blood pressure and the stent);
   * consistency, 1 vs 2 ranks: the same scene on 2 solid ranks gives the same stent diameters and
     per-layer stresses (relative difference below RANK_TOL at every step).
-Usage: test_generic_artery_short.py BIN_DIR [--ranks 1 2] [--end 0.6]
+Usage: test_generic_artery_short.py BIN_DIR [--ranks 1 2] [--end 0.46] [--keep DIR]
 """
 import argparse
 import json
@@ -74,11 +74,14 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("bin_dir", type=Path)
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2])
-    ap.add_argument("--end", type=float, default=0.48)
+    ap.add_argument("--end", type=float, default=0.46)
+    ap.add_argument("--keep", type=Path, help="keep the run directories here")
     args = ap.parse_args()
     scene = short_scene(args.end)
     results = {}
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp_dir:
+        tmp = args.keep or tmp_dir
+        Path(tmp).mkdir(parents=True, exist_ok=True)
         scene_file = Path(tmp) / "generic_artery_short.yaml"
         scene_file.write_text(yaml.safe_dump(scene, sort_keys=False))
         for ranks in args.ranks:
@@ -93,9 +96,10 @@ def main():
 
     for ranks, res in results.items():
         c, steps = res["coupling"], res["solid"]["steps"]
-        check(c["status"] == "ok" and c["steps"] == scene["time"]["steps"],
-              f"{ranks} rank(s): all {scene['time']['steps']} steps committed ({c['status']}, {c['steps']})")
         last = steps[-1]
+        check(c["status"] == "ok" and abs(last["time"] - scene["time"]["end"]) < 1e-9,
+              f"{ranks} rank(s): the run reaches t = {scene['time']['end']} s ({c['status']}, {c['steps']} steps "
+              f"for {scene['time']['steps']} planned, cut steps add steps)")
         force = last["artery_contact_force"]["stent"]
         check(force > 0.0, f"{ranks} rank(s): stent presses on the endothelium at t = {last['time']} ({force:.4g} N)")
         app = last["apposition"]

@@ -8,6 +8,21 @@
 
 using namespace angio::solid;
 
+namespace {
+// Straight one-layer artery tube: inner radius 0.8 mm, wall 0.3 mm, centred at the origin along z.
+Mesh artery_tube(double length, int n_radial, int n_circ, int n_axial) {
+  TubeSpec t;
+  t.part = "artery";
+  t.surface_prefix = "artery_";
+  t.length = length;
+  t.inner_radius = 0.8;
+  t.layers = {{"media", 0.3, n_radial}};
+  t.n_circ = n_circ;
+  t.n_axial = n_axial;
+  return make_tube(t);
+}
+}  // namespace
+
 // Exact: the volume-weighted quantile is the value at which the cumulative weight first reaches q.
 TEST(ArteryMeasures, WeightedQuantile) {
   // values 1..100 with equal weights: the 99 % quantile is 99, the median 50
@@ -29,15 +44,7 @@ TEST(ArteryMeasures, WeightedQuantile) {
 // Exact: the endothelium nodes of a generated tube lie on circles, so every station measures 2 r_i;
 // a rigid translation changes nothing, and a radial scaling of one ring changes only its station.
 TEST(ArteryMeasures, LumenProfileOfATube) {
-  TubeSpec t;
-  t.part = "artery";
-  t.surface_prefix = "artery_";
-  t.length = 4.0;
-  t.inner_radius = 0.8;
-  t.layers = {{"media", 0.3, 1}};
-  t.n_circ = 16;
-  t.n_axial = 8;
-  Mesh m = make_tube(t);
+  const Mesh m = artery_tube(4.0, 1, 16, 8);
   const SurfaceSet* endo = m.surface("artery_inner");
   ASSERT_NE(endo, nullptr);
   std::vector<int> nodes;
@@ -77,15 +84,7 @@ TEST(ArteryMeasures, Apposition) {
 
 // Exact: lumped nodal areas of a surface add up to its area (flat faces of the tube's end ring).
 TEST(ArteryMeasures, NodalAreasSumToTheSurfaceArea) {
-  TubeSpec t;
-  t.part = "artery";
-  t.surface_prefix = "artery_";
-  t.length = 2.0;
-  t.inner_radius = 0.8;
-  t.layers = {{"media", 0.3, 2}};
-  t.n_circ = 12;
-  t.n_axial = 2;
-  const Mesh m = make_tube(t);
+  const Mesh m = artery_tube(2.0, 2, 12, 2);
   const auto area = nodal_areas(m, *m.surface("artery_end0"));
   double sum = 0.0;
   for (double a : area) sum += a;
