@@ -424,10 +424,13 @@ SolveReport SolidModel::solve() {
         ANGIO_PETSC(VecScale(r_, -1.0));
         ANGIO_PETSC(MatZeroRowsColumns(K_, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, du_, r_));
         KSPConvergedReason reason;
+        ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));  // the tangent of the lifting itself
         {
           OptionsScope scope(options_);
           ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
         }
+        ++rep.factorizations;
+        pc_current_ = true;
         ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
         if (reason > 0 || reason == KSP_DIVERGED_ITS) {
           std::vector<double> du_full;
@@ -481,14 +484,27 @@ SolveReport SolidModel::solve() {
     t0 = MPI_Wtime();
     KSPConvergedReason reason;
     PetscInt lits;
-    {
-      OptionsScope scope(options_);
-      ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+    const int lag = no.reuse_preconditioner;
+    for (int attempt = 0;; ++attempt) {
+      const bool reuse = lag > 0 && pc_current_ && attempt == 0;
+      ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse ? PETSC_TRUE : PETSC_FALSE));
+      {
+        OptionsScope scope(options_);
+        ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+      }
+      ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
+      ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
+      rep.linear_iterations += int(lits);
+      if (!reuse) ++rep.factorizations;
+      pc_current_ = true;
+      // an old preconditioner that no longer serves: factorize the current tangent and solve again
+      if (reuse && (reason < 0 || lits > lag)) {
+        if (reason < 0) continue;
+        pc_current_ = false;  // this solve is good; the next one refactorizes
+      }
+      break;
     }
-    ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
-    ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
     rep.linear_seconds += MPI_Wtime() - t0;
-    rep.linear_iterations += int(lits);
     if (reason < 0 && reason != KSP_DIVERGED_ITS) {
       std::ostringstream m;
       m << "linear solver failed at Newton iteration " << it << ": " << KSPConvergedReasons[reason] << " after "
@@ -603,7 +619,10 @@ void SolidModel::commit() {
   u_committed_ = u_;
   committed_time_ = time_;
 }
-void SolidModel::rollback() { u_ = u_committed_; }
+void SolidModel::rollback() {
+  u_ = u_committed_;
+  pc_current_ = false;  // a rejected step restarts from a fresh factorization
+}
 
 void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume) const {
   p1.resize(local_elements_.size());

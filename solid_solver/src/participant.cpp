@@ -166,7 +166,7 @@ void SolidRunner::end_step(bool accept) {
     os << " max_p1[";
     for (size_t b = 0; b < h.max_p1.size(); ++b)
       os << (b ? " " : "") << model_->mesh().blocks[b].name << "=" << h.max_p1[b];
-    os << "]MPa ksp=" << last_.linear_iterations << std::setprecision(3) << " " << last_.total_seconds
+    os << "]MPa ksp=" << last_.linear_iterations << " pc_setups=" << last_.factorizations << std::setprecision(3) << " " << last_.total_seconds
        << "s (assembly " << last_.assembly_seconds << "s, linear " << last_.linear_seconds << "s)";
     LOG_INFO(os.str());
   }

@@ -336,7 +336,8 @@ SolidScene read_solid_scene(const Node& root) {
                                           "contiguous");
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
-      n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping"});
+      n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
+                     "reuse_preconditioner"});
       auto& no = sc.options.newton;
       no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
       no.rtol = n->positive_or("rtol", no.rtol);
@@ -345,6 +346,9 @@ SolidScene read_solid_scene(const Node& root) {
       no.max_line_search = int(n->integer_or("max_line_search", no.max_line_search, 0));
       no.verbose = n->boolean_or("verbose", no.verbose);
       no.damping = n->non_negative_or("damping", no.damping);
+      const long lag = n->integer_or("reuse_preconditioner", no.reuse_preconditioner, 0);
+      if (lag > 1000) n->child("reuse_preconditioner").fail("at most 1000 Krylov iterations per reused preconditioner");
+      no.reuse_preconditioner = int(lag);
     }
   }
   return sc;
