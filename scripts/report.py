@@ -490,11 +490,14 @@ def artery_report(run, scene, solid, beam, with_paper):
 
     # plot data
     t = [s["time"] for s in steps]
+    # stresses on a log axis: without the stress-free reference state (step 0, round-off only)
+    loaded = [s for s in steps if s.get("step") != 0]
+    t_loaded = [s["time"] for s in loaded]
     stress_series = []
     for i, L in enumerate(layers):
-        stress_series.append((f"{L} max", t, [scaled(get(s, "max_principal_stress", L), KPA) for s in steps],
+        stress_series.append((f"{L} max", t_loaded, [scaled(get(s, "max_principal_stress", L), KPA) for s in loaded],
                               "o-", f"C{i}"))
-        stress_series.append((f"{L} p99", t, [scaled(get(s, "p99_principal_stress", L), KPA) for s in steps],
+        stress_series.append((f"{L} p99", t_loaded, [scaled(get(s, "p99_principal_stress", L), KPA) for s in loaded],
                               "--", f"C{i}"))
     lumen_series = []
     for i, k in enumerate(PHASES):
