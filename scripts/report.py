@@ -172,88 +172,7 @@ def artery_layers(solid, scene):
     names = [b.get("name") for b in (get(solid, "blocks") or [])
              if isinstance(b, dict) and b.get("part") == "artery" and isinstance(b.get("name"), str)]
     listed = [l.get("name") for l in (get(scene, "artery", "mesh", "layers") or []) if isinstance(l, dict)]
-    if not names:  # an older summary without parts: the scene's layers that have stresses
-        steps = get(solid, "steps") or []
-        stressed = get(steps[0], "max_principal_stress") if steps else None
-        names = [n for n in listed if isinstance(stressed, dict) and n in stressed]
     return [n for n in listed if n in names] + [n for n in names if n not in listed]
-
-
-def read_centerline(spec, run):
-    """Centerline points of a scene key ([[x,y,z],...], {points: ...} or {file: ...}) and where they
-    came from. A relative file is looked for next to the run's scene.yaml (a copy of the scene), then
-    in the repository's configs/ (the shipped scenes)."""
-    pts = spec.get("points") if isinstance(spec, dict) else spec
-    where = "scene.yaml"
-    if isinstance(spec, dict) and "file" in spec:
-        p = Path(str(spec["file"]))
-        if not p.is_absolute():
-            tries = (run / p, Path(__file__).resolve().parents[1] / "configs" / p)
-            p = next((q for q in tries if q.is_file()), tries[0])
-        where = str(p)
-        try:
-            pts = []
-            for line in p.read_text().splitlines():
-                line = line.split("#")[0].replace(",", " ").split()
-                if line:
-                    pts.append([float(v) for v in line[:3]])
-        except (OSError, ValueError):
-            return None, where
-    if not isinstance(pts, list):
-        return None, where
-    pts = [[float(c) for c in q] for q in pts
-           if isinstance(q, (list, tuple)) and len(q) == 3 and all(num(c) is not None for c in q)]
-    return (pts if len(pts) >= 2 else None), where
-
-
-def polyline_station(pts, cum, x):
-    """Arc length of the point of the polyline nearest to x."""
-    best = (float("inf"), 0.0)
-    for i in range(len(pts) - 1):
-        a, b = pts[i], pts[i + 1]
-        ab = [b[k] - a[k] for k in range(3)]
-        L2 = sum(c * c for c in ab)
-        t = max(0.0, min(1.0, sum((x[k] - a[k]) * ab[k] for k in range(3)) / L2)) if L2 > 0 else 0.0
-        d2 = sum((a[k] + t * ab[k] - x[k]) ** 2 for k in range(3))
-        if d2 < best[0]:
-            best = (d2, cum[i] + t * math.sqrt(L2))
-    return best[1]
-
-
-def stent_extent(run, scene, beam):
-    """(lo, hi) of the stent's final node positions along the artery's station coordinate (the
-    lumen stations: the reference coordinate along the vessel axis, as the solid measures them),
-    and a sentence saying how it was found or why not."""
-    pts = [p for p in (get(beam, "final_positions") or [])
-           if isinstance(p, list) and len(p) == 3 and all(num(c) is not None for c in p)]
-    if not pts:
-        return None, "not determined: no stent node positions (final_positions) in beam/summary.json"
-    mesh = get(scene, "artery", "mesh")
-    if not isinstance(mesh, dict):
-        return None, "not determined: no artery mesh in scene.yaml (or PyYAML missing)"
-    if "centerline" in mesh:
-        cl, where = read_centerline(mesh["centerline"], run)
-        if cl is None:
-            return None, f"not determined: the artery centerline ({where}) is not readable"
-        cum = [0.0]
-        for a, b in zip(cl, cl[1:]):
-            cum.append(cum[-1] + math.dist(a, b))
-        s = [polyline_station(cl, cum, p) for p in pts]
-        how = f"arc length of the nearest point of the artery centerline (polyline of {where})"
-    else:
-        if "file" in mesh:
-            origin, direction = get(mesh, "axis", "origin") or [0, 0, 0], get(mesh, "axis", "direction") or [0, 0, 1]
-        else:
-            origin, direction = mesh.get("center") or [0, 0, 0], [0, 0, 1]
-        try:
-            origin = [float(c) for c in origin]
-            norm = math.sqrt(sum(float(c) ** 2 for c in direction))
-            direction = [float(c) / norm for c in direction]
-        except (TypeError, ValueError, ZeroDivisionError):
-            return None, "not determined: unreadable artery axis in scene.yaml"
-        s = [sum((p[k] - origin[k]) * direction[k] for k in range(3)) for p in pts]
-        how = f"projection on the artery axis (origin {origin}, direction {direction})"
-    return (min(s), max(s)), f"stent node positions after deflation (beam final_positions), {how}"
 
 
 def read_apposition_csv(path):
@@ -413,7 +332,12 @@ def artery_report(run, scene, solid, beam, with_paper):
     for k in PHASES:
         prof = get(ph[k], "lumen_diameter")
         lumen["profiles"][k] = [num(v) for v in prof] if isinstance(prof, list) else None
-    ext, how = stent_extent(run, scene, beam)
+    # the stent's axial extent in the station coordinate, as the solid measured it at the last step
+    ext = get(ph["after"], "stent_stations")
+    ext = (num(ext[0]), num(ext[1])) if isinstance(ext, list) and len(ext) == 2 else None
+    ext = ext if ext and None not in ext else None
+    how = ("solid/summary.json stent_stations of the last step (the beam sample points on the lumen stations)"
+           if ext else "not determined: no stent_stations in solid/summary.json")
     lumen["stent_extent"] = {"min": ext[0], "max": ext[1], "source": how} if ext else {"min": None, "max": None,
                                                                                        "source": how}
     n_st = len(stations)
@@ -429,12 +353,7 @@ def artery_report(run, scene, solid, beam, with_paper):
     for k in PHASES:
         prof = lumen["profiles"][k]
         vals = [v for v, m in zip(prof, mask) if m and v is not None] if prof and len(prof) == n_st else []
-        if vals:
-            lumen["min"][k] = min(vals)
-        else:  # no profile: the solid's minimum over all stations
-            lumen["min"][k] = phase_out[k]["lumen_diameter_min_all_stations"]
-            if lumen["min"][k] is not None:
-                lumen.setdefault("min_scope", {})[k] = "all stations (no lumen profile)"
+        lumen["min"][k] = min(vals) if vals else None
     a, b = lumen["profiles"]["prestressed"], lumen["profiles"]["after"]
     if a and b and len(a) == len(b) == n_st:
         gain = [y - x if x is not None and y is not None else None for x, y in zip(a, b)]
@@ -451,8 +370,7 @@ def artery_report(run, scene, solid, beam, with_paper):
     where = "stented" if scope == "stented" else "all stations"
     for k in PHASES:
         if lumen["min"].get(k) is not None:
-            w = "all stations" if k in lumen.get("min_scope", {}) else where
-            rows.append((f"min lumen diameter {k}, {w} (mm)", lumen["min"][k], None))
+            rows.append((f"min lumen diameter {k}, {where} (mm)", lumen["min"][k], None))
     if lumen["gain_mean"] is not None:
         rows.append((f"lumen gain after - prestressed, mean {where} (mm)", lumen["gain_mean"], None))
 
@@ -462,16 +380,8 @@ def artery_report(run, scene, solid, beam, with_paper):
     app_csv = read_apposition_csv(run / "solid" / "apposition.csv")
     ap = {"threshold": thr, "time": times["after"] if app else None,
           "source": "solid/summary.json, last step" if app else None}
-    if app:
-        for key in ("stent_length", "malapposed_length", "malapposed_fraction", "max_gap", "mean_gap"):
-            ap[key] = num(app.get(key))
-    elif (app_csv and app_csv["malapposed_fraction"] is not None and times["after"] is not None
-          and at_time([app_csv], times["after"]) is not None):  # older summary: the CSV, if of the last step
-        ap.update(time=app_csv["time"], source="solid/apposition.csv",
-                  stent_length=app_csv["stent_length"], malapposed_length=app_csv["malapposed_length"],
-                  malapposed_fraction=app_csv["malapposed_fraction"], max_gap=app_csv["max_gap"], mean_gap=None)
-        if thr is None:
-            ap["threshold"] = thr = app_csv["threshold"]
+    for key in ("stent_length", "malapposed_length", "malapposed_fraction", "max_gap", "mean_gap"):
+        ap[key] = num(get(app, key))
     ap["malapposed_percent"] = scaled(ap.get("malapposed_fraction"), 100.0)
     ap["csv"] = app_csv
     section["apposition"] = ap

@@ -353,7 +353,7 @@ void BeamModel::assemble_global(SpMat* K, Eigen::VectorXd& rg) {
       const double N2 = gauss_xi_[k], N1 = 1.0 - N2;
       const double w = gauss_w_[k] * eref_[e].L0;
       Vec3 q = q_ext_[g] + elem_q_[e] + elem_p_dead_[e] * ref_radial_[g];
-      for (int j = 0; j < planes_per_point_ && !planes_.empty(); ++j) {
+      for (int j = 0; j < planes_per_point_; ++j) {  // 0 without planes
         const SamplePlane& pl = planes_[g * planes_per_point_ + j];
         if (!(pl.eps > 0.0)) continue;
         const participant::PlanePenalty pp = participant::plane_penalty(

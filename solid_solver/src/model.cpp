@@ -485,8 +485,8 @@ SolveReport SolidModel::solve() {
     KSPConvergedReason reason;
     PetscInt lits;
     const int lag = no.reuse_preconditioner;
-    for (int attempt = 0;; ++attempt) {
-      const bool reuse = lag > 0 && pc_current_ && attempt == 0;
+    bool reuse = lag > 0 && pc_current_;
+    auto linear_solve = [&] {
       ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse ? PETSC_TRUE : PETSC_FALSE));
       {
         OptionsScope scope(options_);
@@ -496,14 +496,13 @@ SolveReport SolidModel::solve() {
       ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
       rep.linear_iterations += int(lits);
       if (!reuse) ++rep.factorizations;
-      pc_current_ = true;
-      // an old preconditioner that no longer serves: factorize the current tangent and solve again
-      if (reuse && (reason < 0 || lits > lag)) {
-        if (reason < 0) continue;
-        pc_current_ = false;  // this solve is good; the next one refactorizes
-      }
-      break;
+    };
+    linear_solve();
+    if (reuse && reason < 0) {  // the old preconditioner no longer serves: factorize this tangent
+      reuse = false;
+      linear_solve();
     }
+    pc_current_ = !(reuse && lits > lag);  // slow with the old one: the next solve refactorizes
     rep.linear_seconds += MPI_Wtime() - t0;
     if (reason < 0 && reason != KSP_DIVERGED_ITS) {
       std::ostringstream m;

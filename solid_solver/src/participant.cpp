@@ -123,6 +123,7 @@ void SolidRunner::begin_step(int step, double time) {
 
 participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply) {
   if (stent_contact_) stent_contact_->set_points(pts);
+  stent_x_ = pts.x;
   if (!pts.x.empty() && !stent_contact_ && !warned_contact_ && rank_ == 0) {
     LOG_WARN("solid: no stent contact configured; " << pts.x.size()
                                                      << " beam sample points are ignored (zero line loads)");
@@ -207,7 +208,6 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
     weights[b].push_back(all[k + 2]);
     if (all[k + 1] > best[b]) {
       best[b] = all[k + 1];
-      s.stress[b].max = all[k + 1];
       s.stress[b].where = Vec3d(all[k + 3], all[k + 4], all[k + 5]);
     }
   }
@@ -227,6 +227,15 @@ void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_
   for (const auto& [part, u] : umax) s.max_displacement.emplace_back(part, u);
   if (lumen_.empty()) return;
   s.lumen_diameter = lumen_.diameters(x);
+  if (!stent_x_.empty()) {  // where the stent sits, in the station coordinate of the lumen profile
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& p : stent_x_) {
+      const double st = scene_.lumen->station(Vec3d(p[0], p[1], p[2]));
+      lo = std::min(lo, st);
+      hi = std::max(hi, st);
+    }
+    s.stent_stations = std::make_pair(lo, hi);
+  }
   // contact on the endothelium: force per contact model, and the pressure field of all of them
   contact_pressure.assign(mesh.X.size(), 0.0);
   std::vector<Vec3d> total(mesh.X.size(), Vec3d::Zero());
@@ -361,6 +370,7 @@ void SolidRunner::write_summary_json_() const {
       e["lumen_diameter_min"] = *lo;
       e["lumen_diameter_max"] = *hi;
     }
+    if (s.stent_stations) e["stent_stations"] = {s.stent_stations->first, s.stent_stations->second};
     for (const auto& [name, f] : s.artery_contact_force) e["artery_contact_force"][name] = f;
     if (s.apposition) {
       const auto& a = *s.apposition;

@@ -5,8 +5,7 @@
 namespace angio::solid {
 
 double viscous_rate_factor(double xi) {
-  if (xi < 1e-8) return 1.0 - 0.5 * xi;  // series: 1 − ξ/2 + ξ²/6 − …
-  return -std::expm1(-xi) / xi;
+  return xi == 0.0 ? 1.0 : -std::expm1(-xi) / xi;  // expm1: no cancellation for small ξ
 }
 
 Vec6 viscous_update(const ViscousBranch& v, double dt, const Vec6& Q_n, const Vec6& S_inf_n, const Vec6& S_inf,

@@ -102,6 +102,9 @@ def main():
               f"for {scene['time']['steps']} planned, cut steps add steps)")
         force = last["artery_contact_force"]["stent"]
         check(force > 0.0, f"{ranks} rank(s): stent presses on the endothelium at t = {last['time']} ({force:.4g} N)")
+        st, ext = res["solid"]["lumen_stations"], last.get("stent_stations")
+        check(ext is not None and min(st) < ext[0] < ext[1] < max(st),
+              f"{ranks} rank(s): the stent's extent {ext} lies within the lumen stations [{min(st)}, {max(st)}]")
         app = last["apposition"]
         check(app["malapposed_fraction"] < 1.0, f"{ranks} rank(s): part of the stent is apposed "
               f"(malapposed {100 * app['malapposed_fraction']:.1f} %, max gap {app['max_gap']:.3f} mm)")

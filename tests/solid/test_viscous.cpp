@@ -69,10 +69,11 @@ TEST(Viscous, SecondOrderForSmoothHistory) {
   }
 }
 
-// g(ξ) = (1 − e^(−ξ))/ξ is continuous through its series branch and g(0) = 1 (instantaneous response).
+// g(ξ) = (1 − e^(−ξ))/ξ is accurate for small ξ (no cancellation) and g(0) = 1 (instantaneous response).
 TEST(Viscous, RateFactorLimits) {
   EXPECT_EQ(viscous_rate_factor(0.0), 1.0);
   EXPECT_NEAR(viscous_rate_factor(1e-8), viscous_rate_factor(1.0000001e-8), 1e-15);
+  EXPECT_NEAR(viscous_rate_factor(1e-12), 1.0 - 0.5e-12, 1e-16);  // no cancellation near 0
   const double x = 1e-3;  // series reference (the closed form cancels at this ξ)
   EXPECT_NEAR(viscous_rate_factor(x), 1.0 - x / 2 + x * x / 6 - x * x * x / 24 + x * x * x * x / 120, 1e-15);
   EXPECT_NEAR(viscous_rate_factor(50.0), 1.0 / 50.0, 1e-15);

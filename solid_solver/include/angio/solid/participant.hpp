@@ -40,8 +40,8 @@ void reset_reply(const participant::SamplePoints& points, participant::ContactRe
 
 // First principal Cauchy stress of one block (layer) at one step (per element: the eigenvalue of
 // the Gauss-point averaged Cauchy tensor).
+// (The maximum itself is StepSummary::max_p1, known on every rank.)
 struct BlockStress {
-  double max = 0.0;              // MPa
   Vec3d where = Vec3d::Zero();   // current centroid of the element with the maximum
   double p99 = 0.0;              // 99th percentile by reference volume (MPa), robust against one element at a strut
 };
@@ -57,6 +57,7 @@ struct StepSummary {
   std::vector<double> lumen_diameter;                      // per lumen station (mm)
   std::vector<std::pair<std::string, double>> artery_contact_force;  // per contact: Σ |nodal force| on the endothelium (N)
   std::optional<Apposition> apposition;                    // stent vs endothelium
+  std::optional<std::pair<double, double>> stent_stations; // axial extent of the stent on the lumen stations (mm)
   double d_mid = 0.0, d_end0 = 0.0, d_end1 = 0.0;          // balloon outer diameter (mm)
   int newton_iterations = 0;
   double residual = 0.0;
@@ -112,6 +113,7 @@ class SolidRunner : public participant::SolidParticipant {
   LumenProfile lumen_;
   std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner (by node)
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
+  std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
   void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
   void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
   void write_apposition_csv_(const std::vector<double>& gap, const std::vector<double>& weight) const;
