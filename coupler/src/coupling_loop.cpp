@@ -15,6 +15,14 @@ std::string newton_failure(const char* who, int k, const participant::SolveStats
          s.message + ", residual history " + log::list(s.residual_history);
 }
 
+// |w r| (N): the coupling residual r (N/mm per sample point, 3 per point) weighted by the arc lengths.
+double weighted_norm(const Eigen::VectorXd& r, const std::vector<double>& w) {
+  double s = 0.0;
+  for (std::size_t i = 0; i < w.size() && 3 * i + 2 < std::size_t(r.size()); ++i)
+    s += w[i] * w[i] * r.segment<3>(3 * i).squaredNorm();
+  return std::sqrt(s);
+}
+
 }  // namespace
 
 RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
@@ -27,6 +35,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
   const double sqrt_len = std::sqrt(static_cast<double>(3 * n));
   auto scheme = make_interface_scheme(settings.scheme, n);
 
+  double first_residual_force = 0.0;  // |w r_0| of the last accepted step (N): iteration 0's solid tolerance
   auto step_start = Clock::now();
   while (!stepper.finished()) {
     StepReport rep;
@@ -43,6 +52,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     std::string failure;
     double smallest = std::numeric_limits<double>::infinity();  // residual, since the last restart
     int k_restart = 0;  // iteration of the last restart: the acceleration counts from there
+    double solid_tolerance = settings.inexact_solid * first_residual_force;
+    double step_first_force = 0.0;
     for (int k = 0; k < settings.max_iterations; ++k) {
       auto t0 = Clock::now();
       participant::SolveStats bs = scheme->solve_beam(beam);
@@ -54,7 +65,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       }
       rep.beam_points = beam.sample_points();
       t0 = Clock::now();
-      participant::SolveStats ss = solid.solve(rep.beam_points, rep.contact);  // positions in
+      participant::SolveStats ss = solid.solve(rep.beam_points, rep.contact, solid_tolerance);  // positions in
       rep.solid_time += seconds_since(t0);
       if (!ss.converged) {
         participant_failed = true;
@@ -75,6 +86,9 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       for (const auto& q : reply.line_loads) q_norm += q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
       q_norm = std::sqrt(q_norm);
       const double rn = r.norm();
+      const double r_force = weighted_norm(r, rep.beam_points.w);
+      if (k == 0) step_first_force = r_force;
+      solid_tolerance = settings.inexact_solid * r_force;
       rep.residuals.push_back(rn);
       rep.iterations = k + 1;
       LOG_DEBUG("step " << rep.step << " iteration " << k << ": ||r|| = " << rn << ", ||q~|| = "
@@ -119,6 +133,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
                        << " iterations (residual " << rep.residuals.back()
                        << "), accepted because coupling.strict is false");
     rep.converged = converged;
+    first_residual_force = step_first_force;
     beam.end_step(true);
     solid.end_step(true);
     acc.end_step(true);

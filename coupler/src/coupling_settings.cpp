@@ -9,7 +9,7 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   auto c = root.optional("coupling");
   if (!c) return s;
   c->check_keys({"scheme", "acceleration", "initial_relaxation", "max_relaxation", "max_iterations",
-                 "rel_tol", "abs_tol", "strict", "restart_growth", "prediction", "record", "iqn"});
+                 "rel_tol", "abs_tol", "strict", "restart_growth", "prediction", "record", "iqn", "inexact_solid"});
   s.scheme = c->choice_or("scheme", {"dirichlet-neumann", "robin"}, s.scheme);
   s.acceleration = c->choice_or("acceleration", {"aitken", "iqn-ils", "constant"}, s.acceleration);
   if (c->has("initial_relaxation")) s.initial_relaxation = c->in_range("initial_relaxation", 1e-6, 2.0);
@@ -39,6 +39,7 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   }
   s.prediction = c->choice_or("prediction", {"constant", "extrapolate"}, s.prediction);
   s.record = c->boolean_or("record", s.record);
+  if (c->has("inexact_solid")) s.inexact_solid = c->in_range("inexact_solid", 0.0, 1.0);
   return s;
 }
 

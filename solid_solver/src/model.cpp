@@ -369,7 +369,11 @@ bool SolidModel::assemble(Vec r, Mat K) {
   }
   int all_ok = 0;
   MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
-  if (all_ok && contact_) contact_->add(*this, r, K);
+  if (all_ok && contact_) {
+    const double tc = MPI_Wtime();
+    contact_->add(*this, r, K);
+    contact_seconds_ += MPI_Wtime() - tc;
+  }
   ANGIO_PETSC(VecAssemblyBegin(r));
   ANGIO_PETSC(VecAssemblyEnd(r));
   if (K) {
@@ -388,9 +392,10 @@ bool SolidModel::assemble(Vec r, Mat K) {
   return all_ok != 0;
 }
 
-SolveReport SolidModel::solve() {
+SolveReport SolidModel::solve(double loose_atol) {
   SolveReport rep;
   const double t_start = MPI_Wtime();
+  const double contact_start = contact_seconds_;
   const auto& no = opt_.newton;
   // Prescribed displacement increment: lifted through one linearised solve at the old state
   // (du_D = increment, K_FD du_D moved to the right-hand side), so the first iterate is a
@@ -453,12 +458,23 @@ SolveReport SolidModel::solve() {
     rep.converged = false;
     rep.message = msg;
     rep.total_seconds = MPI_Wtime() - t_start;
+    rep.contact_seconds = contact_seconds_ - contact_start;
     return rep;
   };
-  double t0 = MPI_Wtime();
-  bool ok = assemble(r_, K_);
-  rep.assembly_seconds += MPI_Wtime() - t0;
-  if (!ok) return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN)");
+  // Residual (and, with `tangent`, the tangent) at the current u_; false for an invalid configuration.
+  auto assemble_here = [&](bool tangent) {
+    const double ta = MPI_Wtime();
+    const bool aok = assemble(r_, tangent ? K_ : nullptr);
+    rep.assembly_seconds += MPI_Wtime() - ta;
+    if (tangent) ++rep.tangent_assemblies;
+    return aok;
+  };
+  const bool modified = no.modified;
+  const double atol = std::max(no.atol, loose_atol);
+  // fresh: K_ holds the tangent at the current iterate (to be factorized); otherwise the modified
+  // Newton iterates with the factorization held by the KSP.
+  bool fresh = !modified || !pc_current_;
+  if (!assemble_here(fresh)) return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN)");
   double res = norm(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
@@ -467,7 +483,7 @@ SolveReport SolidModel::solve() {
   for (int it = 0;; ++it) {
     rep.iterations = it;
     rep.residual = res;
-    if (res <= no.atol || (it > 0 && res <= no.rtol * res0)) {
+    if (res <= atol || (it > 0 && res <= no.rtol * res0)) {
       rep.converged = true;
       rep.message = "converged";
       if (damping_diag_) rep.damping_force = damping_(nullptr, nullptr);
@@ -481,11 +497,11 @@ SolveReport SolidModel::solve() {
     }
     // linear solve K du = -r
     ANGIO_PETSC(VecScale(r_, -1.0));
-    t0 = MPI_Wtime();
+    double t0 = MPI_Wtime();
     KSPConvergedReason reason;
     PetscInt lits;
     const int lag = no.reuse_preconditioner;
-    bool reuse = lag > 0 && pc_current_;
+    bool reuse = modified ? !fresh : lag > 0 && pc_current_;
     auto linear_solve = [&] {
       ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse ? PETSC_TRUE : PETSC_FALSE));
       {
@@ -498,11 +514,22 @@ SolveReport SolidModel::solve() {
       if (!reuse) ++rep.factorizations;
     };
     linear_solve();
-    if (reuse && reason < 0) {  // the old preconditioner no longer serves: factorize this tangent
-      reuse = false;
-      linear_solve();
+    if (modified) {
+      pc_current_ = reason > 0 || reason == KSP_DIVERGED_ITS;
+      if (reuse && reason < 0) {  // the old factorization no longer serves: the current tangent instead
+        rep.linear_seconds += MPI_Wtime() - t0;
+        if (!assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
+        fresh = true;
+        rep.residual_history.push_back(res);
+        continue;
+      }
+    } else {
+      if (reuse && reason < 0) {  // the old preconditioner no longer serves: factorize this tangent
+        reuse = false;
+        linear_solve();
+      }
+      pc_current_ = !(reuse && lits > lag);  // slow with the old one: the next solve refactorizes
     }
-    pc_current_ = !(reuse && lits > lag);  // slow with the old one: the next solve refactorizes
     rep.linear_seconds += MPI_Wtime() - t0;
     if (reason < 0 && reason != KSP_DIVERGED_ITS) {
       std::ostringstream m;
@@ -515,17 +542,18 @@ SolveReport SolidModel::solve() {
     for (double v : du_full) finite = finite && std::isfinite(v);
     if (!finite) return fail("linear solve produced NaN/Inf at Newton iteration " + std::to_string(it));
     u_base = u_;
-    // line search (backtracking on ||r||); the tangent is assembled with the trial residual so
-    // that an accepted full step costs no extra assembly. alpha ends as the last trial's step.
+    // line search (backtracking on ||r||); exact Newton assembles the tangent with the trial
+    // residual so that an accepted full step costs no extra assembly. alpha ends as the last
+    // trial's step. A step of an old factorization (modified Newton) gets no line search: if it
+    // does not reduce ||r||, it is undone and the current tangent factorized instead.
+    const bool stale = modified && !fresh;
     double alpha = 1.0, best_alpha = 1.0, best_res = std::numeric_limits<double>::infinity();
     double new_res = 0.0;
     bool accepted = false;
-    const int tries = no.line_search ? no.max_line_search + 1 : 1;
+    const int tries = no.line_search && !stale ? no.max_line_search + 1 : 1;
     for (int ls = 0;; ++ls, alpha *= 0.5) {
       for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
-      t0 = MPI_Wtime();
-      const bool aok = assemble(r_, K_);
-      rep.assembly_seconds += MPI_Wtime() - t0;
+      const bool aok = assemble_here(!modified);
       new_res = aok ? norm(r_) : std::numeric_limits<double>::infinity();
       if (!std::isfinite(new_res)) new_res = std::numeric_limits<double>::infinity();
       if (new_res < best_res) {
@@ -535,26 +563,38 @@ SolveReport SolidModel::solve() {
       accepted = new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res));
       if (accepted || ls + 1 >= tries) break;
     }
-    if (!accepted) {
+    if (stale && !(new_res < res)) {  // the old factorization diverges here: back, and the current tangent
+      u_ = u_base;
+      if (!assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
+      fresh = true;
+      rep.residual_history.push_back(res);
+      continue;
+    }
+    if (!accepted && !stale) {
       if (!std::isfinite(best_res))
         return fail("Newton iteration " + std::to_string(it) +
                     ": every line-search trial gave an invalid configuration (inverted element or NaN)");
-      if (best_alpha != alpha) {  // r_, K_ hold the last trial: back to the best one
+      if (best_alpha != alpha) {  // r_ (and K_) hold the last trial: back to the best one
         alpha = best_alpha;
         for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
-        t0 = MPI_Wtime();
-        assemble(r_, K_);
-        rep.assembly_seconds += MPI_Wtime() - t0;
+        assemble_here(!modified);
         new_res = norm(r_);
       }
+    }
+    if (modified) {
+      // keep the factorization while it contracts fast enough; otherwise the tangent here, for the
+      // next iteration (the residual is assembled again with it)
+      fresh = !(new_res <= no.max_contraction * res) && new_res > atol && !(new_res <= no.rtol * res0);
+      if (fresh && !assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
     }
     res = new_res;
     rep.residual_history.push_back(res);
     if (no.verbose && rank_ == 0)
-      std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d\n", it + 1, res,
-                  alpha, int(lits));
+      std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s\n", it + 1, res, alpha, int(lits),
+                  stale ? " (old factorization)" : "");
   }
   rep.total_seconds = MPI_Wtime() - t_start;
+  rep.contact_seconds = contact_seconds_ - contact_start;
   return rep;
 }
 

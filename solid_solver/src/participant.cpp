@@ -121,7 +121,8 @@ void SolidRunner::begin_step(int step, double time) {
   model_->set_time(time);
 }
 
-participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply) {
+participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply,
+                                           double tolerance) {
   if (stent_contact_) stent_contact_->set_points(pts);
   stent_x_ = pts.x;
   if (!pts.x.empty() && !stent_contact_ && !warned_contact_ && rank_ == 0) {
@@ -130,7 +131,8 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
     warned_contact_ = true;
   }
   reset_reply(pts, reply);
-  last_ = model_->solve();
+  last_ = model_->solve(tolerance);
+  totals_.add(last_);
   if (stent_contact_ && last_.converged) stent_contact_->fill_reply(*model_, reply);
   participant::SolveStats s;
   s.converged = last_.converged;
@@ -341,6 +343,23 @@ void SolidRunner::write_summary_json_() const {
     j["artery_contact_force_measure"] = "sum over the endothelium nodes of |nodal contact force| (N), per contact";
     j["apposition_threshold"] = scene_.apposition_threshold;
   }
+  {  // every solve so far (rejected steps and coupling iterations included), seconds on rank 0
+    const auto& t = totals_;
+    int ranks = 1;
+    MPI_Comm_size(comm_, &ranks);
+    j["timing"] = {{"ranks", ranks},
+                   {"dofs", model_->num_dofs()},
+                   {"solves", t.solves},
+                   {"newton_iterations", t.newton_iterations},
+                   {"tangent_assemblies", t.tangent_assemblies},
+                   {"factorizations", t.factorizations},
+                   {"linear_iterations", t.linear_iterations},
+                   {"assembly_seconds", t.assembly_seconds},
+                   {"contact_seconds", t.contact_seconds},
+                   {"linear_seconds", t.linear_seconds},
+                   {"solve_seconds", t.total_seconds},
+                   {"note", "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest"}};
+  }
   j["steps"] = ordered_json::array();
   for (const auto& s : history_) {
     ordered_json e;
@@ -396,6 +415,7 @@ void SolidRunner::write_summary_json_() const {
 void SolidRunner::finish() {
   if (finished_) return;
   finished_ = true;
+  if (writer_ && rank_ == 0) write_summary_json_();  // the timing of the solves after the last commit
   if (writer_) writer_->close();
 }
 
@@ -425,14 +445,15 @@ void MpiSolidParticipant::begin_step(int step, double time) {
 }
 
 participant::SolveStats MpiSolidParticipant::solve(const participant::SamplePoints& pts,
-                                                   participant::ContactReply& reply) {
+                                                   participant::ContactReply& reply, double tolerance) {
   int cmd = kSolve;
   MPI_Bcast(&cmd, 1, MPI_INT, 0, comm_);
+  MPI_Bcast(&tolerance, 1, MPI_DOUBLE, 0, comm_);
   participant::SamplePoints p = pts;
   if (p.w.size() != p.x.size()) p.w.resize(p.x.size(), 0.0);
   if (p.radius.size() != p.x.size()) p.radius.resize(p.x.size(), 0.0);
   bcast_points(p, comm_);
-  return inner_.solve(p, reply);
+  return inner_.solve(p, reply, tolerance);
 }
 
 void MpiSolidParticipant::end_step(bool accept) {
@@ -466,10 +487,12 @@ int run_follower(participant::SolidParticipant& inner, MPI_Comm comm) {
         break;
       }
       case kSolve: {
+        double tolerance = 0.0;
+        MPI_Bcast(&tolerance, 1, MPI_DOUBLE, 0, comm);
         participant::SamplePoints p;
         bcast_points(p, comm);
         participant::ContactReply reply;
-        inner.solve(p, reply);
+        inner.solve(p, reply, tolerance);
         break;
       }
       case kEnd: {

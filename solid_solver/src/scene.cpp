@@ -337,7 +337,7 @@ SolidScene read_solid_scene(const Node& root) {
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
       n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
-                     "reuse_preconditioner"});
+                     "reuse_preconditioner", "tangent", "max_contraction"});
       auto& no = sc.options.newton;
       no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
       no.rtol = n->positive_or("rtol", no.rtol);
@@ -349,6 +349,13 @@ SolidScene read_solid_scene(const Node& root) {
       const long lag = n->integer_or("reuse_preconditioner", no.reuse_preconditioner, 0);
       if (lag > 1000) n->child("reuse_preconditioner").fail("at most 1000 Krylov iterations per reused preconditioner");
       no.reuse_preconditioner = int(lag);
+      no.modified = n->choice_or("tangent", {"exact", "modified"}, "exact") == "modified";
+      no.max_contraction = n->positive_or("max_contraction", no.max_contraction);
+      if (!(no.max_contraction < 1.0)) n->child("max_contraction").fail("a contraction factor between 0 and 1 (exclusive)");
+      if (n->optional("max_contraction") && !no.modified)
+        n->child("max_contraction").fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");
+      if (no.modified && no.reuse_preconditioner > 0)
+        n->child("reuse_preconditioner").fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
     }
   }
   return sc;

@@ -85,7 +85,7 @@ struct WallSolid : participant::SolidParticipant {
   double s = 1.0;
   void begin_step(int, double t) override { s = x0 + (s_max - x0) * t; }
   participant::SolveStats solve(const participant::SamplePoints& p,
-                                participant::ContactReply& reply) override {
+                                participant::ContactReply& reply, double /*tolerance: exact*/) override {
     reply = {};
     for (std::size_t i = 0; i < p.size(); ++i) {
       const double g = s - p.x[i][0] - p.radius[i];

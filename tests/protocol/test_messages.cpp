@@ -35,8 +35,9 @@ TEST(Messages, BeamSolveRequestRoundTrip) {
 
 TEST(Messages, SolidSolveRoundTrip) {
   auto pts = points(5);
-  auto req = msg::solid_solve_request(coupler(1), 1, 0, pts);
+  auto req = msg::solid_solve_request(coupler(1), 1, 0, pts, 2.5e-3);
   const auto& r = msg::payload_as<fb::SolidSolveRequest>(msg::open(req, "run-A"));
+  EXPECT_EQ(r.tolerance(), 2.5e-3);
   auto back = msg::to_sample_points(r.sample_points());
   EXPECT_EQ(back.x, pts.x);
   EXPECT_EQ(back.w, pts.w);
@@ -161,7 +162,7 @@ TEST(Messages, SequenceChecks) {
 TEST(Messages, MismatchedSamplePointArraysAreRejected) {
   auto pts = points(4);
   pts.w.pop_back();
-  auto buf = msg::solid_solve_request(coupler(1), 1, 0, pts);
+  auto buf = msg::solid_solve_request(coupler(1), 1, 0, pts, 0.0);
   const auto& r = msg::payload_as<fb::SolidSolveRequest>(msg::open(buf, "run-A"));
   EXPECT_THROW(msg::to_sample_points(r.sample_points()), ProtocolError);
 }

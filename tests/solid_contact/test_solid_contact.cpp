@@ -164,7 +164,7 @@ solid:
   }
   participant::ContactReply reply;
   runner.begin_step(1, 1.0);
-  const auto st = runner.solve(pts, reply);
+  const auto st = runner.solve(pts, reply, 0.0);
   ASSERT_TRUE(st.converged) << st.message;
   EXPECT_EQ(reply.n_active, 24);
   EXPECT_LT(reply.min_gap, 0.0);

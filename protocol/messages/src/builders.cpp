@@ -77,9 +77,9 @@ Buffer beam_solve_reply(const Header& h, const participant::SolveStats& s, doubl
 }
 
 Buffer solid_solve_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                           const participant::SamplePoints& pts) {
+                           const participant::SamplePoints& pts, double tolerance) {
   FlatBufferBuilder b(256 + 40 * pts.size());
-  auto p = fb::CreateSolidSolveRequest(b, step, iteration, points(b, pts));
+  auto p = fb::CreateSolidSolveRequest(b, step, iteration, points(b, pts), tolerance);
   return finish(b, h, fb::Payload::SolidSolveRequest, p.Union());
 }
 

@@ -130,9 +130,9 @@ void RemoteSolid::begin_step(int step, double time) {
   ch_.call("step_begin", [&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
 }
 
-SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply) {
+SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply, double tolerance) {
   auto b = ch_.call("solve", [&](const msg::Header& h) {
-    return msg::solid_solve_request(h, step_, iteration_, pts);
+    return msg::solid_solve_request(h, step_, iteration_, pts, tolerance);
   });
   const auto& r = reply_as<fb::SolidSolveReply>(b);
   account(ch_, r.stats());

@@ -63,7 +63,7 @@ int run_standalone(SolidParticipant& solid, const scene::TimeSettings& time) {
   ContactReply reply;
   return run(
       time, [&](int n, double t) { solid.begin_step(n, t); },
-      [&] { return solid.solve(SamplePoints{}, reply); }, [&](bool a) { solid.end_step(a); },
+      [&] { return solid.solve(SamplePoints{}, reply, 0.0); }, [&](bool a) { solid.end_step(a); },
       [&] { solid.finish(); });
 }
 

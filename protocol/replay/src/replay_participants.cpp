@@ -78,6 +78,17 @@ void check_vectors(const Cursor& c, const char* what, const std::vector<particip
   }
 }
 
+// A scalar of the request (e.g. the solve tolerance), compared relative to max(1, |recorded|).
+void check_scalar(const Cursor& c, const char* what, double got, double rec, double tol) {
+  const double d = std::abs(got - rec) / std::max(1.0, std::abs(rec));
+  if (!(d <= tol)) {
+    std::ostringstream os;
+    os << "exchange " << c.position() - 1 << ": " << what << " " << got << " but recorded " << rec << ", tolerance "
+       << tol;
+    throw ReplayMismatch(os.str());
+  }
+}
+
 }  // namespace
 
 ReplayBeam::ReplayBeam(const recording::Recording& rec, double tol)
@@ -114,9 +125,10 @@ void ReplaySolid::begin_step(int step, double time) {
 }
 
 participant::SolveStats ReplaySolid::solve(const participant::SamplePoints& pts,
-                                           participant::ContactReply& reply) {
+                                           participant::ContactReply& reply, double tolerance) {
   const auto& req = *cursor_.next(fb::Payload::SolidSolveRequest).payload_as_SolidSolveRequest();
   check_vectors(cursor_, "sample-point positions", pts.x, msg::to_sample_points(req.sample_points()).x, tol_);
+  check_scalar(cursor_, "solve tolerance", tolerance, req.tolerance(), tol_);
   const auto& r = msg::payload_as<fb::SolidSolveReply>(cursor_.reply());
   reply = msg::to_contact(r);
   return msg::to_stats(r.stats());

@@ -37,6 +37,13 @@ struct CouplingSettings {
   double restart_growth = 0.0;
   std::string prediction = "extrapolate";
   bool record = false;
+  // Inexact solid solves: > 0 lets the solid solve coupling iteration k to an absolute residual of
+  // inexact_solid x |w r_(k-1)| (N; r the coupling residual in N/mm, w the sample points' arc
+  // lengths), iteration 0 to that factor times the previous step's first residual, so that its
+  // equilibrium error stays this fraction of the interface error it is iterated against; the
+  // accepted iterate's solid error is then at most that fraction of the residual before it.
+  // 0: every solve to the solid's own tolerance.
+  double inexact_solid = 0.0;
 };
 
 CouplingSettings coupling_settings(const scene::Node& root);

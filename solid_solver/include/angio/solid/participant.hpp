@@ -72,7 +72,7 @@ class SolidRunner : public participant::SolidParticipant {
 
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const participant::SamplePoints& beam_points,
-                                participant::ContactReply& reply) override;
+                                participant::ContactReply& reply, double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
 
@@ -87,6 +87,7 @@ class SolidRunner : public participant::SolidParticipant {
   void clear_contact_reports() { contact_reports_.clear(); }
   const std::vector<StepSummary>& history() const { return history_; }
   const SolveReport& last_report() const { return last_; }
+  const SolveTotals& totals() const { return totals_; }
   // Balloon outer diameters (mm) at mid-length and both ends for the current state (all ranks).
   void balloon_diameters(double& mid, double& end0, double& end1) const;
 
@@ -102,6 +103,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::unique_ptr<FieldWriter> writer_;
   std::vector<StepSummary> history_;
   SolveReport last_;
+  SolveTotals totals_;  // every solve of the run, rejected steps included
   int step_ = 0;
   int committed_ = 0;
   double time_ = 0.0;
@@ -125,7 +127,7 @@ class MpiSolidParticipant : public participant::SolidParticipant {
   MpiSolidParticipant(participant::SolidParticipant& inner, MPI_Comm comm) : inner_(inner), comm_(comm) {}
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const participant::SamplePoints& beam_points,
-                                participant::ContactReply& reply) override;
+                                participant::ContactReply& reply, double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
   // Releases the followers if finish() was never called (e.g. the coupler vanished).

@@ -25,7 +25,7 @@ Buffer beam_solve_request(const Header& h, std::uint32_t step, std::uint32_t ite
 Buffer beam_solve_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
                         const participant::SamplePoints& points);
 Buffer solid_solve_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                           const participant::SamplePoints& points);
+                           const participant::SamplePoints& points, double tolerance);
 Buffer solid_solve_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
                          const participant::ContactReply& contact);
 Buffer step_end(const Header& h, std::uint32_t step, bool accept);

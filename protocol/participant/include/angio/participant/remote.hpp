@@ -93,7 +93,7 @@ class RemoteSolid : public SolidParticipant {
   explicit RemoteSolid(Channel& channel) : ch_(channel) {}
   std::string hello();
   void begin_step(int step, double time) override;
-  SolveStats solve(const SamplePoints& beam_points, ContactReply& reply) override;
+  SolveStats solve(const SamplePoints& beam_points, ContactReply& reply, double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
   void set_iteration(int k) { iteration_ = k; }

@@ -13,8 +13,9 @@ class SolidParticipant {
   // Sets pressures etc. from the load curves at pseudo-time `time` (end of the step).
   virtual void begin_step(int step, double time) = 0;
   // Solves equilibrium with the beam sample points held fixed; fills the contact reply.
-  // Empty `beam_points` means no stent.
-  virtual SolveStats solve(const SamplePoints& beam_points, ContactReply& reply) = 0;
+  // Empty `beam_points` means no stent. tolerance > 0: the absolute residual (N) the coupler allows
+  // for this solve (inexact solves inside the coupling loop); 0: the participant's own tolerance.
+  virtual SolveStats solve(const SamplePoints& beam_points, ContactReply& reply, double tolerance) = 0;
   // accept: commit history and write output; reject: roll back to the last committed state.
   virtual void end_step(bool accept) = 0;
   virtual void finish() = 0;

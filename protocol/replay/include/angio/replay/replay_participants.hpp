@@ -66,7 +66,7 @@ class ReplaySolid : public participant::SolidParticipant {
   ReplaySolid(const recording::Recording& rec, double tolerance);
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const participant::SamplePoints& points,
-                                participant::ContactReply& reply) override;
+                                participant::ContactReply& reply, double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
 

@@ -1,0 +1,215 @@
+#!/usr/bin/env python3
+"""Benchmark of the shipped coupled scenes: one table row per scene, and the price of the coupling.
+
+  scripts/bench_scenes.py                                  # every coupled scene in configs/
+  scripts/bench_scenes.py straight_free_expansion --compare old.json
+  scripts/bench_scenes.py configs/generic_artery.yaml --no-alone --json bench.json
+
+Each scene runs through scripts/launch.py (the processes and settings a user gets), then
+scripts/report.py derives its results. A row holds: wall time, load steps, rejected attempts
+(cuts), coupling iterations (mean, max), solid Newton iterations and factorizations, the time split
+(solid assembly of which contact, solid linear solve, beam, messaging), the peak resident memory of
+the largest process, and the stent diameter at peak and final. The same balloon (and artery)
+without the stent then runs alone (solid-only scene: same steps, solver and loads, `--no-alone`
+skips it); coupled/alone is the price of the coupling.
+
+The rows go to a JSON file (--json, default bench_scenes.json in the output directory);
+--compare OLD.json prints the ratios new/old per scene and the changes of the results.
+Units: s, MiB, mm. Run on an idle machine: the figures are wall times.
+"""
+import argparse
+import copy
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+
+
+def coupled_scenes():
+    out = []
+    for name in sorted(os.listdir(os.path.join(ROOT, "configs"))):
+        if not name.endswith(".yaml"):
+            continue
+        s = yaml.safe_load(open(os.path.join(ROOT, "configs", name)))
+        if isinstance(s, dict) and "stent" in s and ("balloon" in s or "artery" in s):
+            out.append(os.path.join(ROOT, "configs", name))
+    return out
+
+
+def resolve(scene):
+    for cand in (scene, os.path.join(ROOT, "configs", scene), os.path.join(ROOT, "configs", scene + ".yaml")):
+        if os.path.isfile(cand):
+            return os.path.abspath(cand)
+    sys.exit(f"bench_scenes: no scene '{scene}' (a path or a name in configs/)")
+
+
+def alone_scene(scene):
+    """The solid-only variant: no stent, no coupling, no stent contact; the rest as in the scene."""
+    s = copy.deepcopy(scene)
+    s.pop("stent", None)
+    s.pop("coupling", None)
+    c = s.get("contact")
+    if isinstance(c, dict):
+        for k in ("stent_balloon", "stent_artery", "line_regularization", "line_normals"):
+            c.pop(k, None)
+    return s
+
+
+def launch(scene_path, run_dir, build_dir, ranks):
+    """Runs one scene through the launcher; returns (exit code, wall s, peak RSS MiB of the largest process)."""
+    cmd = [sys.executable, os.path.join(ROOT, "scripts", "launch.py"), scene_path, "--run-dir", run_dir,
+           "--build-dir", build_dir]
+    if ranks:
+        cmd += ["--ranks", str(ranks)]
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    log = open(run_dir + ".out", "w")
+    t0 = time.time()
+    p = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+    # wait4: the rusage of the launcher and everything it waited for (mpirun, the solvers);
+    # ru_maxrss is the largest resident set of any of them (KiB on Linux)
+    _, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    return p.returncode, time.time() - t0, usage.ru_maxrss / 1024.0
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return {}
+
+
+def row_of(name, run_dir, rc, wall, rss):
+    c = load(os.path.join(run_dir, "coupling_summary.json"))
+    t = load(os.path.join(run_dir, "solid", "summary.json")).get("timing", {})
+    subprocess.run([PYTHON, os.path.join(ROOT, "scripts", "report.py"), run_dir], capture_output=True)
+    stent = load(os.path.join(run_dir, "results.json")).get("stent", {})
+    return {
+        "scene": name,
+        "status": c.get("status", f"exit {rc}") if rc == 0 else f"exit {rc}",
+        "wall_s": wall,
+        "steps": c.get("steps"),
+        "cuts": c.get("rejected_attempts"),
+        "coupling_iterations_mean": c.get("coupling_iterations_mean"),
+        "coupling_iterations_max": c.get("coupling_iterations_max"),
+        "solid_ranks": t.get("ranks"),
+        "solid_dofs": t.get("dofs"),
+        "solid_solves": t.get("solves"),
+        "solid_newton_iterations": t.get("newton_iterations"),
+        "solid_factorizations": t.get("factorizations"),
+        "solid_s": c.get("solid_time"),
+        "solid_assembly_s": t.get("assembly_seconds"),
+        "solid_contact_s": t.get("contact_seconds"),
+        "solid_linear_s": t.get("linear_seconds"),
+        "beam_s": c.get("beam_time"),
+        "messaging_s": c.get("messaging_time"),
+        "peak_rss_mib": rss,
+        "stent_diameter_max": stent.get("max"),
+        "stent_diameter_final": stent.get("final"),
+        "recoil_percent": stent.get("recoil_percent"),
+    }
+
+
+def alone_row(run_dir, rc, wall, rss):
+    s = load(os.path.join(run_dir, "solid", "summary.json"))
+    t = s.get("timing", {})
+    return {"status": "ok" if rc == 0 else f"exit {rc}", "wall_s": wall, "steps": len(s.get("steps", [])) - 1,
+            "solid_newton_iterations": t.get("newton_iterations"), "peak_rss_mib": rss}
+
+
+def fmt(v, spec):
+    return "-" if v is None else format(v, spec)
+
+
+def print_table(rows):
+    head = (f"{'scene':<26}{'status':>7}{'wall s':>9}{'steps':>6}{'cuts':>5}{'it mean':>8}{'it max':>7}"
+            f"{'newton':>7}{'LU':>6}{'assem s':>8}{'(cont.)':>8}{'lin s':>7}{'beam s':>7}{'msg s':>6}"
+            f"{'MiB':>6}{'D max':>7}{'D fin':>7}{'alone s':>8}{'c/a':>6}")
+    print(head)
+    for r in rows:
+        a = r.get("alone") or {}
+        ratio = r["wall_s"] / a["wall_s"] if a.get("wall_s") else None
+        print(f"{r['scene']:<26}{r['status']:>7}{r['wall_s']:>9.1f}{fmt(r['steps'], 'd'):>6}{fmt(r['cuts'], 'd'):>5}"
+              f"{fmt(r['coupling_iterations_mean'], '.2f'):>8}{fmt(r['coupling_iterations_max'], 'd'):>7}"
+              f"{fmt(r['solid_newton_iterations'], 'd'):>7}{fmt(r['solid_factorizations'], 'd'):>6}"
+              f"{fmt(r['solid_assembly_s'], '.1f'):>8}{fmt(r['solid_contact_s'], '.1f'):>8}"
+              f"{fmt(r['solid_linear_s'], '.1f'):>7}{fmt(r['beam_s'], '.1f'):>7}{fmt(r['messaging_s'], '.1f'):>6}"
+              f"{r['peak_rss_mib']:>6.0f}{fmt(r['stent_diameter_max'], '.3f'):>7}{fmt(r['stent_diameter_final'], '.3f'):>7}"
+              f"{fmt(a.get('wall_s'), '.1f'):>8}{fmt(ratio, '.2f'):>6}")
+
+
+def compare(rows, old_path):
+    old = {r["scene"]: r for r in load(old_path).get("rows", [])}
+    if not old:
+        sys.exit(f"bench_scenes: {old_path} holds no rows")
+    print(f"\nagainst {old_path} (commit {load(old_path).get('commit', '?')}):")
+    print(f"{'scene':<26}{'wall old':>9}{'wall new':>9}{'speedup':>8}{'dD max mm':>11}{'dD fin mm':>11}")
+    for r in rows:
+        o = old.get(r["scene"])
+        if not o:
+            print(f"{r['scene']:<26} (not in the old file)")
+            continue
+        def d(k):
+            return None if r.get(k) is None or o.get(k) is None else r[k] - o[k]
+        print(f"{r['scene']:<26}{o['wall_s']:>9.1f}{r['wall_s']:>9.1f}{o['wall_s'] / r['wall_s']:>8.2f}"
+              f"{fmt(d('stent_diameter_max'), '+.4f'):>11}{fmt(d('stent_diameter_final'), '+.4f'):>11}")
+
+
+def git_commit():
+    r = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    dirty = subprocess.run(["git", "-C", ROOT, "diff", "--quiet", "HEAD"]).returncode != 0
+    return r.stdout.strip() + ("+changes" if dirty else "")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scenes", nargs="*", help="scene files or names in configs/ (default: every coupled scene)")
+    ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "bench"), help="run directories go here")
+    ap.add_argument("--json", help="rows written here (default: OUT_DIR/bench_scenes.json)")
+    ap.add_argument("--compare", metavar="OLD.json", help="rows of an earlier run to compare with")
+    ap.add_argument("--no-alone", action="store_true", help="skip the solid-only runs")
+    ap.add_argument("--ranks", type=int, help="solid ranks (default: the scene's solid.ranks)")
+    ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
+    a = ap.parse_args()
+    scenes = [resolve(s) for s in a.scenes] if a.scenes else coupled_scenes()
+    os.makedirs(a.out_dir, exist_ok=True)
+    rows = []
+    for path in scenes:
+        name = os.path.splitext(os.path.basename(path))[0]
+        run_dir = os.path.join(a.out_dir, name)
+        subprocess.run(["rm", "-rf", run_dir, run_dir + "_alone"])
+        print(f"[bench] {name} ...", file=sys.stderr, flush=True)
+        rc, wall, rss = launch(path, run_dir, a.build_dir, a.ranks)
+        row = row_of(name, run_dir, rc, wall, rss)
+        if not a.no_alone:
+            alone_path = os.path.join(a.out_dir, name + "_alone.yaml")
+            with open(alone_path, "w") as f:
+                f.write("# generated by scripts/bench_scenes.py: " + name + " without the stent\n")
+                yaml.safe_dump(alone_scene(yaml.safe_load(open(path))), f, sort_keys=False)
+            print(f"[bench] {name} alone ...", file=sys.stderr, flush=True)
+            rc_a, wall_a, rss_a = launch(alone_path, run_dir + "_alone", a.build_dir, a.ranks)
+            row["alone"] = alone_row(run_dir + "_alone", rc_a, wall_a, rss_a)
+        rows.append(row)
+    out = a.json or os.path.join(a.out_dir, "bench_scenes.json")
+    doc = {"commit": git_commit(), "machine": f"{platform.node()} {os.cpu_count()} cpus {platform.processor()}",
+           "date": time.strftime("%Y-%m-%d %H:%M"), "rows": rows}
+    with open(out, "w") as f:
+        json.dump(doc, f, indent=1)
+    print(f"commit {doc['commit']}, {doc['machine']}, {doc['date']}")
+    print_table(rows)
+    print(f"(rows in {out})")
+    if a.compare:
+        compare(rows, a.compare)
+    return 0 if all(r["status"] == "ok" for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
