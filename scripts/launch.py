@@ -10,10 +10,16 @@ parallel runs apart. Ctrl-C is forwarded to every process; if one process fails,
 stopped and the exit code names the failing process. Units in scenes: mm, N, MPa, s.
 """
 import argparse
+import ctypes
+import difflib
+import fcntl
+import math
 import os
-import shutil
+import re
+import shlex
 import signal
 import socket
+import stat
 import subprocess
 import sys
 import threading
@@ -25,6 +31,16 @@ import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 UNIX_PATH_MAX = 107
+# The top-level sections some executable reads (README "Scenes"). The launcher picks the processes
+# from these keys, so a misspelt one must stop the launch instead of silently running another
+# simulation (a scene without its `stent` runs the balloon alone).
+SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling")
+# Catches typos (-n 2000 oversubscribes the machine into the ground) without limiting real runs.
+MAX_RANKS = 256
+# The run id is a chunk of the zenoh key expressions angio/<run_id>/...: '/' would shift the chunks
+# and '*', '$', '?', '#' are wildcards or reserved, i.e. could reach another run's processes.
+RUN_ID = re.compile(r"[A-Za-z0-9._-]{1,64}")
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
 
 
 def die(msg, code=2):
@@ -32,17 +48,91 @@ def die(msg, code=2):
     sys.exit(code)
 
 
+def shown(v, n=60):
+    """repr(v) cut to n characters: a message stays one readable line whatever the value."""
+    r = repr(v)
+    return r if len(r) <= n else r[:n - 3] + "..."
+
+
+class DuplicateKey(Exception):
+    pass
+
+
+class SceneLoader(yaml.SafeLoader):
+    """SafeLoader that refuses a key given twice in one map. PyYAML keeps the last one silently, so
+    a scene with `E:` twice in stent.material would run with whichever came last.
+
+    The check runs on the composed node tree, before anything is constructed: nested maps are
+    constructed out of document order (generators), so a construct_mapping override would not know
+    their key path, and merge keys (`<<: *defaults`) are flattened into the maps in place there,
+    after which an overridden merged key would look like a duplicate."""
+
+    def construct_document(self, node):
+        self._check(node, "", set())
+        return super().construct_document(node)
+
+    def _check(self, node, path, seen):
+        if id(node) in seen:  # an alias of a node already checked (or a recursive one)
+            return
+        seen.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            first = {}
+            for k, v in node.value:
+                name = k.value if isinstance(k, yaml.ScalarNode) else "?"
+                sub = f"{path}.{name}" if path else name
+                if isinstance(k, yaml.ScalarNode) and k.tag != "tag:yaml.org,2002:merge":
+                    line = k.start_mark.line + 1
+                    if (k.tag, k.value) in first:
+                        raise DuplicateKey(sub, first[(k.tag, k.value)], line)
+                    first[(k.tag, k.value)] = line
+                self._check(v, sub, seen)
+        elif isinstance(node, yaml.SequenceNode):
+            for i, v in enumerate(node.value):
+                self._check(v, f"{path}[{i}]", seen)
+
+
 def load_scene(path):
+    """The scene as a dict of known sections, or exit 2 with a message naming the file."""
     try:
-        with open(path) as f:
-            scene = yaml.safe_load(f)
+        st = os.stat(path)
+        if not stat.S_ISREG(st.st_mode):  # a directory, or a FIFO or device that never ends
+            kind = "a directory" if stat.S_ISDIR(st.st_mode) else "not a regular file"
+            die(f"{path}: expected a scene file (YAML), got {kind}")
+        with open(path, "rb") as f:
+            data = f.read()
     except FileNotFoundError:
         die(f"{path}: no such scene file")
-    except yaml.YAMLError as e:
-        die(f"{path}: YAML syntax error: {e}")
+    except OSError as e:
+        die(f"{path}: cannot read the scene file: {e.strerror}")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        die(f"{path}: expected a YAML text file (UTF-8), got byte 0x{data[e.start]:02x} at offset {e.start}")
+    try:
+        scene = yaml.load(text, Loader=SceneLoader)
+    except DuplicateKey as e:
+        key, a, b = e.args
+        lines = f"lines {a} and {b}" if a != b else f"line {a}"
+        die(f"{path}: {key}: expected each key once in a map, got it twice ({lines})")
+    except yaml.MarkedYAMLError as e:
+        m = e.problem_mark
+        where = f"line {m.line + 1}, column {m.column + 1}: " if m else ""
+        what = " ".join(f"{e.problem or ''} {e.context or ''}".split())
+        die(f"{path}: {where}expected valid YAML, got a syntax error: {what}")
+    except yaml.YAMLError as e:  # e.g. a control character (ReaderError)
+        die(f"{path}: expected valid YAML, got: {' '.join(str(e).split())}")
+    except RecursionError:
+        die(f"{path}: expected a scene, got YAML nested too deeply to read")
+    if scene is None:
+        die(f"{path}: expected a YAML map of sections, got an empty document")
     if not isinstance(scene, dict):
-        die(f"{path}: expected a YAML map at the top level")
-    return scene
+        die(f"{path}: expected a YAML map of sections at the top level, got a {type(scene).__name__}")
+    for key in scene:
+        if key not in SECTIONS:
+            near = difflib.get_close_matches(str(key), SECTIONS, n=1)
+            hint = f"; did you mean `{near[0]}`?" if near else ""
+            die(f"{path}: {key}: expected a top-level section ({', '.join(SECTIONS)}), got an unknown key{hint}")
+    return scene, data
 
 
 def free_tcp_port():
@@ -69,35 +159,145 @@ def find_binary(build_dir, name):
     return str(p)
 
 
-def int_setting(scene, section, key, default, scene_path):
-    sec = scene.get(section) or {}
-    v = sec.get(key, default) if isinstance(sec, dict) else default
-    if not isinstance(v, int) or v < 1:
-        die(f"{scene_path}: {section}.{key}: expected an integer >= 1, got {v!r}")
+def solid_ranks(scene, scene_path):
+    sec = scene.get("solid")
+    if sec is None:
+        return 1
+    if not isinstance(sec, dict):
+        die(f"{scene_path}: solid: expected a map, got {shown(sec)}")
+    v = sec.get("ranks", 1)
+    # bool is an int in Python: `ranks: true` must not run one rank
+    if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= MAX_RANKS:
+        die(f"{scene_path}: solid.ranks: expected an integer in 1..{MAX_RANKS}, got {shown(v)}")
     return v
+
+
+def ranks_arg(text):
+    try:
+        v = int(text)
+    except ValueError:
+        v = 0
+    if not 1 <= v <= MAX_RANKS:
+        raise argparse.ArgumentTypeError(f"expected an integer in 1..{MAX_RANKS}, got {text!r}")
+    return v
+
+
+def command_arg(option, text):
+    try:
+        cmd = shlex.split(text)  # quotes as in a shell: paths with spaces, python -c '...'
+    except ValueError as e:
+        die(f"{option}: expected a command line, got {shown(text)} ({e})")
+    if not cmd:
+        die(f"{option}: expected a command line, got an empty one")
+    return cmd
+
+
+def make_run_dir(run_dir, explicit):
+    """Creates the run directory owner-only (it holds the coupler's socket: whoever can connect to it
+    can talk to the solvers); an explicit --run-dir that exists is reused."""
+    try:
+        run_dir.mkdir(mode=0o700, parents=True)
+        os.chmod(run_dir, 0o700)  # mkdir's mode is masked by the umask
+    except FileExistsError:
+        if not explicit:  # a fresh default name that exists: never write into someone else's run
+            die(f"{run_dir}: expected a new run directory, got an existing one; pass --run-dir")
+        if not run_dir.is_dir():
+            die(f"{run_dir}: expected a run directory, got an existing file")
+    except OSError as e:
+        die(f"{run_dir}: cannot create the run directory: {e.strerror}")
+
+
+def lock_run_dir(run_dir):
+    """Holds <run_dir>/launch.lock (flock) until the launcher exits. The kernel drops the lock when
+    the launcher dies however it dies, so a leftover file never blocks a later launch. Returns the
+    open file: the lock lives as long as it."""
+    try:
+        f = open(run_dir / "launch.lock", "a+")
+    except OSError as e:
+        die(f"{run_dir}: cannot write to the run directory: {e.strerror}")
+    try:
+        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        f.seek(0)
+        other = f.read().strip() or "?"
+        die(f"{run_dir}: expected a free run directory, got one in use by another launch (pid {other}); "
+            "pass another --run-dir")
+    f.seek(0)
+    f.truncate()
+    f.write(f"{os.getpid()}\n")
+    f.flush()
+    # A coupler started some other way (an older launcher, by hand) holds zenoh's lock on its socket:
+    # starting a second one here would unlink that socket under the running coupler.
+    zlock = run_dir / "coupler.sock.lock"
+    if zlock.exists():
+        try:
+            with open(zlock) as z:
+                fcntl.flock(z, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            die(f"{run_dir}: expected a free run directory, got one in use by another launch "
+                "(a running coupler holds coupler.sock.lock); pass another --run-dir")
+        except OSError as e:
+            die(f"{zlock}: cannot check the coupler's lock: {e.strerror}")
+    return f
+
+
+def die_with_launcher():
+    """preexec_fn for every child: PR_SET_PDEATHSIG makes the kernel send SIGTERM to the child when
+    the launcher dies, even by SIGKILL, where no handler of ours runs (mpirun passes SIGTERM on to its
+    ranks). preexec_fn runs between fork and exec while the pump threads of earlier children exist,
+    so it only calls a prctl resolved here, before the fork. None where there is no prctl."""
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+    parent, sig = os.getpid(), ctypes.c_ulong(int(signal.SIGTERM))
+
+    def preexec():
+        prctl(PR_SET_PDEATHSIG, sig)
+        if os.getppid() != parent:  # the launcher died before the prctl: no signal will come
+            os._exit(128 + int(signal.SIGTERM))
+    return preexec
 
 
 class Proc:
     def __init__(self, name, cmd, log_path, echo_all=True):
         self.name = name
         self.echo_all = echo_all
+        self.echo_ok = True
         self.cmd = cmd
         self.log = open(log_path, "w")
         # Own process group: Ctrl-C reaches the launcher only, which forwards it deliberately.
+        # errors="replace": a byte that is not UTF-8 in a solver's output must not kill the pump.
         self.p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                  start_new_session=True, text=True, bufsize=1)
+                                  start_new_session=True, preexec_fn=die_with_launcher(),
+                                  text=True, errors="replace", bufsize=1)
         self.t = threading.Thread(target=self._pump, daemon=True)
         self.t.start()
 
     def _pump(self):
+        # Whatever happens to the terminal or the disk, the pipe is drained to the end: a pump that
+        # stopped would block the process on its next line once the pipe buffer is full.
         for line in self.p.stdout:
             # In coupled runs the coupler's line per step is the progress; participants show
             # only their warnings and errors on the terminal (everything is in their log file).
-            if self.echo_all or "WARN" in line or "ERROR" in line or "rror" in line:
-                sys.stdout.write(line)
-                sys.stdout.flush()
-            self.log.write(line)
-            self.log.flush()
+            if self.echo_ok and (self.echo_all or "WARN" in line or "ERROR" in line or "rror" in line):
+                try:
+                    sys.stdout.write(line)
+                    sys.stdout.flush()
+                except (OSError, ValueError):  # terminal gone, stdout closed (| head)
+                    self.echo_ok = False
+            if self.log:
+                try:
+                    self.log.write(line)
+                    self.log.flush()
+                except OSError as e:  # disk full: say so once, keep draining
+                    self.log = None
+                    try:
+                        print(f"launch: warning: {self.name}.log: {e.strerror}; log incomplete", file=sys.stderr)
+                    except (OSError, ValueError):
+                        pass
 
     def signal(self, sig):
         if self.p.poll() is None:
@@ -122,9 +322,10 @@ def stop_all(procs, grace=5.0):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="scene file (YAML)")
-    ap.add_argument("--run-dir", help="run directory (default: runs/<scene>-<time>)")
+    ap.add_argument("--run-dir", help="run directory (default: runs/<scene>-<time>-<token>); "
+                    "refused while another launch uses it")
     ap.add_argument("--build-dir", default=str(ROOT / "build"), help="CMake build directory")
-    ap.add_argument("--ranks", type=int, help="MPI ranks of the solid solver (overrides solid.ranks)")
+    ap.add_argument("--ranks", type=ranks_arg, help="MPI ranks of the solid solver (overrides solid.ranks)")
     ap.add_argument("--transport", choices=["auto", "unix", "tcp"], default="auto")
     ap.add_argument("--record", action="store_true", help="record all exchanges (coupled scenes)")
     ap.add_argument("--timeout", type=float, default=600.0, help="peer silence timeout, s")
@@ -135,39 +336,58 @@ def main():
     ap.add_argument("--beam-cmd", help="replace the beam participant executable (same CLI)")
     ap.add_argument("--solid-cmd", help="replace the solid participant executable (same CLI)")
     args = ap.parse_args()
+    if not (math.isfinite(args.timeout) and args.timeout > 0):
+        die(f"--timeout: expected a positive number of seconds, got {args.timeout}")
+    if args.run_id is not None and not RUN_ID.fullmatch(args.run_id):
+        die(f"--run-id: expected 1 to 64 of A-Z a-z 0-9 . _ -, got {shown(args.run_id)}")
 
     # One BLAS thread per process: the solid runs one MPI rank per core, and a threaded OpenBLAS under
     # MUMPS would oversubscribe the cores (a user's explicit setting wins).
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
         os.environ.setdefault(var, "1")
+    # All of the input is checked before the run directory exists: bad input leaves nothing behind.
     scene_path = Path(args.scene).resolve()
-    scene = load_scene(scene_path)
+    scene, scene_text = load_scene(scene_path)
     has_stent = "stent" in scene
     has_solid = "balloon" in scene or "artery" in scene
     if not has_stent and not has_solid:
-        die(f"{scene_path}: the scene has none of 'stent', 'balloon', 'artery': nothing to simulate")
+        die(f"{scene_path}: expected at least one of 'stent', 'balloon', 'artery', got none: nothing to simulate")
+    ranks = solid_ranks(scene, scene_path)
+    if args.ranks is not None:
+        ranks = args.ranks
 
     build = Path(args.build_dir).resolve()
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    run_dir = Path(args.run_dir or ROOT / "runs" / f"{scene_path.stem}-{stamp}").resolve()
-    run_dir.mkdir(parents=True, exist_ok=True)
-    shutil.copy(scene_path, run_dir / "scene.yaml")
-    run_id = args.run_id or uuid.uuid4().hex[:12]
-    common = ["--scene", str(scene_path), "--run-dir", str(run_dir), "--log-level", args.log_level,
-              "--timeout", str(args.timeout)]
-
-    ranks = args.ranks or int_setting(scene, "solid", "ranks", 1, scene_path)
     mpirun = ["mpirun", "-n", str(ranks), "--oversubscribe", "--bind-to", "none"]
     if os.geteuid() == 0:
         mpirun.append("--allow-run-as-root")
-    beam_exe = args.beam_cmd.split() if args.beam_cmd else [find_binary(build, "beam_solver")] if has_stent else None
-    solid_exe = (args.solid_cmd.split() if args.solid_cmd else mpirun + [find_binary(build, "solid_solver")]) if has_solid else None
+    beam_exe = solid_exe = coupler_exe = None
+    if has_stent:
+        beam_exe = command_arg("--beam-cmd", args.beam_cmd) if args.beam_cmd else [find_binary(build, "beam_solver")]
+    if has_solid:
+        solid_exe = command_arg("--solid-cmd", args.solid_cmd) if args.solid_cmd else mpirun + [find_binary(build, "solid_solver")]
+    if has_stent and has_solid:
+        coupler_exe = [find_binary(build, "coupler")]
+
+    token = uuid.uuid4().hex[:12]
+    run_id = args.run_id or token
+    # The token makes the default name unique for launches of one scene in the same second (with a
+    # random run id it is the run id).
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    run_dir = Path(args.run_dir or ROOT / "runs" / f"{scene_path.stem}-{stamp}-{token}").resolve()
+    make_run_dir(run_dir, explicit=args.run_dir is not None)
+    lock = lock_run_dir(run_dir)  # the flock lasts as long as this open file, i.e. until main returns
+    try:
+        (run_dir / "scene.yaml").write_bytes(scene_text)  # the text that was checked
+    except OSError as e:
+        die(f"{run_dir / 'scene.yaml'}: cannot write: {e.strerror}")
+    common = ["--scene", str(scene_path), "--run-dir", str(run_dir), "--log-level", args.log_level,
+              "--timeout", str(args.timeout)]
 
     plan = []
     if has_stent and has_solid:
         endpoint = pick_endpoint(run_dir, args.transport)
         coupled = ["--endpoint", endpoint, "--run-id", run_id]
-        coupler = [find_binary(build, "coupler")] + common + coupled + (["--record"] if args.record else [])
+        coupler = coupler_exe + common + coupled + (["--record"] if args.record else [])
         plan = [("coupler", coupler), ("beam_solver", beam_exe + common + coupled),
                 ("solid_solver", solid_exe + common + coupled)]
     elif has_stent:
@@ -234,4 +454,15 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Bad input exits 2 through die() (SystemExit passes through here); anything else is a bug of the
+    # launcher: one line instead of a traceback. Children still running get SIGTERM from the kernel
+    # as the launcher exits (die_with_launcher).
+    try:
+        code = main()
+    except KeyboardInterrupt:  # Ctrl-C before the handler forwarding it is installed
+        print("launch: interrupted", file=sys.stderr)
+        code = 130
+    except Exception as e:
+        print(f"launch: internal error: {type(e).__name__}: {' '.join(str(e).split())}", file=sys.stderr)
+        code = 1
+    sys.exit(code)
