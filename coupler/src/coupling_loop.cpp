@@ -113,6 +113,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       rep.omega = acc.last_factor();
     }
 
+    run.beam_time += rep.beam_time;  // every attempt: a rejected one cost its solves too
+    run.solid_time += rep.solid_time;
     const bool accept =
         converged || (!participant_failed && !settings.strict && rep.iterations > 0);
     if (!accept) {
@@ -143,10 +145,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     run.steps++;
     run.total_iterations += rep.iterations;
     run.max_iterations = std::max(run.max_iterations, rep.iterations);
-    run.beam_time += rep.beam_time;
-    run.solid_time += rep.solid_time;
     if (on_step) on_step(rep);
-    stepper.accept();
+    stepper.accept(rep.iterations);
     step_start = Clock::now();
   }
   run.wall_time = seconds_since(run_start);

@@ -84,8 +84,10 @@ struct WallSolid : participant::SolidParticipant {
   double x0 = 1.0;
   double s = 1.0;
   void begin_step(int, double t) override { s = x0 + (s_max - x0) * t; }
+  std::vector<double> tolerances;  // of every solve request (the wall is solved exactly anyway)
   participant::SolveStats solve(const participant::SamplePoints& p,
-                                participant::ContactReply& reply, double /*tolerance: exact*/) override {
+                                participant::ContactReply& reply, double tolerance) override {
+    tolerances.push_back(tolerance);
     reply = {};
     for (std::size_t i = 0; i < p.size(); ++i) {
       const double g = s - p.x[i][0] - p.radius[i];

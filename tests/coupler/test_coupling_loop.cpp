@@ -203,3 +203,34 @@ TEST(CouplingLoop, ResidualGrowthRestartsTheAcceleration) {
   EXPECT_EQ(acc.begins, 1 + reports[0].restarts);
   EXPECT_NEAR(beam.x_committed[0], 1.0 + analytic_q(beam, wall) / beam.kb, 1e-8);
 }
+
+// Inexact solid solves (coupling.inexact_solid = eta), consistency of the bookkeeping: the solid is
+// asked for the absolute tolerance eta·|w r| of the coupling residual before it (weights w = 0.1
+// per point here, so |w r| = 0.1·||r||), iteration 0 of a step for eta times the previous accepted
+// step's first residual, and the very first solve for its own tolerance (0). Off (eta = 0): always 0.
+TEST(CouplingLoop, InexactSolidToleranceFollowsTheCouplingResidual) {
+  for (const double eta : {0.0, 0.1}) {
+    test::SpringBeam beam;
+    test::WallSolid wall;
+    coupler::CouplingSettings s;
+    s.rel_tol = 1e-8;
+    s.abs_tol = 1e-12;
+    s.inexact_solid = eta;
+    coupler::Aitken aitken(0.5, 1.0);
+    const auto reports = run_ramp(beam, wall, 3, s, aitken);
+    ASSERT_EQ(reports.size(), 3u);
+    std::size_t solve = 0;
+    double previous_first = 0.0;
+    for (const auto& rep : reports) {
+      for (std::size_t k = 0; k < rep.residuals.size(); ++k, ++solve) {
+        ASSERT_LT(solve, wall.tolerances.size());
+        const double expected = eta * 0.1 * (k == 0 ? previous_first : rep.residuals[k - 1]);
+        EXPECT_NEAR(wall.tolerances[solve], expected, 1e-14 + 1e-12 * expected) << "step " << rep.step << " iteration " << k;
+      }
+      previous_first = rep.residuals[0];
+    }
+    EXPECT_EQ(solve, wall.tolerances.size());
+    EXPECT_GT(solve, reports.size());  // some step iterates, so some tolerance follows a residual
+    if (eta > 0) EXPECT_GT(wall.tolerances.back(), 0.0);
+  }
+}

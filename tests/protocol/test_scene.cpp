@@ -95,4 +95,18 @@ TEST(Scene, TimeSettings) {
   EXPECT_DOUBLE_EQ(t.min_step, 0.02 / 1024.0);
   expect_error([] { time_settings(inline_scene("time: {end: 1, steps: 0}")); }, {"time.steps", ">= 1"});
   expect_error([] { time_settings(inline_scene("time: {start: 2, end: 1, steps: 3}")); }, {"time.end"});
+  // stops: the load-curve corners strictly inside (start, end), sorted, each once
+  const TimeSettings c = time_settings(inline_scene(
+      "time: {end: 2, steps: 4}\nload_curves: {a: [[0, 0], [1.3, 1], [2, 0]], b: [[-1, 0], [0.5, 1], [1.3, 2], [3, 0]]}"));
+  EXPECT_EQ(c.stops, (std::vector<double>{0.5, 1.3}));
+  EXPECT_EQ(c.max_step, 0.0);  // adaptive steps off unless asked for
+  const TimeSettings a = time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 3}}"));
+  EXPECT_DOUBLE_EQ(a.max_step, 0.1);
+  EXPECT_EQ(a.easy_iterations, 3);
+  expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.01}}")); },
+               {"time.adaptive.max_step", "larger than the nominal"});
+  expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy: 2}}")); },
+               {"time.adaptive", "easy"});
+  expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 0}}")); },
+               {"time.adaptive.easy_iterations"});
 }

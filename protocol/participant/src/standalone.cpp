@@ -36,7 +36,7 @@ int run(const scene::TimeSettings& time, const std::function<void(int, double)>&
       // The participant logs its own line per committed step (with its physical measures).
       LOG_DEBUG("step " << stepper.step() << " t = " << stepper.time() << " s: " << s.iterations
                        << " Newton iterations, residual " << s.residual << ", " << wall << " s");
-      stepper.accept();
+      stepper.accept(s.iterations);
     }
   } catch (const StepFailure& e) {
     LOG_ERROR(e.what());

@@ -1,5 +1,6 @@
 #include "angio/scene/load_curve.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace angio::scene {
@@ -77,13 +78,29 @@ TimeSettings time_settings(const Node& root) {
   TimeSettings ts;
   auto t = root.optional("time");
   if (!t) return ts;
-  t->check_keys({"start", "end", "steps", "min_step", "max_cuts"});
+  t->check_keys({"start", "end", "steps", "min_step", "max_cuts", "adaptive"});
   ts.start = t->number_or("start", 0.0);
   ts.end = t->number("end");
   if (!(ts.end > ts.start)) t->child("end").fail("a time larger than time.start");
   ts.steps = static_cast<int>(t->integer("steps", 1));
-  ts.min_step = t->positive_or("min_step", (ts.end - ts.start) / ts.steps / 1024.0);
+  const double nominal = (ts.end - ts.start) / ts.steps;
+  ts.min_step = t->positive_or("min_step", nominal / 1024.0);
   ts.max_cuts = static_cast<int>(t->integer_or("max_cuts", 10, 0));
+  if (const auto a = t->optional("adaptive")) {
+    a->check_keys({"max_step", "easy_iterations"});
+    ts.max_step = a->number("max_step");
+    if (!(ts.max_step > nominal * (1.0 + 1e-12) && ts.max_step <= ts.end - ts.start))
+      a->child("max_step").fail("a step larger than the nominal one ((end - start)/steps = " + std::to_string(nominal) +
+                                " s) and at most end - start");
+    const long easy = a->integer_or("easy_iterations", ts.easy_iterations, 1);
+    if (easy > 1000) a->child("easy_iterations").fail("at most 1000 iterations");
+    ts.easy_iterations = static_cast<int>(easy);
+  }
+  for (const auto& [name, curve] : load_curves(root))
+    for (const auto& [tc, v] : curve.points())
+      if (tc > ts.start && tc < ts.end) ts.stops.push_back(tc);
+  std::sort(ts.stops.begin(), ts.stops.end());
+  ts.stops.erase(std::unique(ts.stops.begin(), ts.stops.end()), ts.stops.end());
   return ts;
 }
 

@@ -2,8 +2,11 @@
 //
 // A step that fails (no Newton or coupling convergence) is retried with half the increment; after
 // a success the increment grows back (doubling) toward the nominal one, never stepping across a
-// point of the nominal grid, so load-curve corners are hit exactly. Below the minimum
-// increment the stepper gives up with an error naming the time and the increment.
+// point of the nominal grid or a load-curve corner (TimeSettings::stops), so corners are hit
+// exactly. With adaptive steps (TimeSettings::max_step) an easy step (at most easy_iterations
+// iterations) at full size lets the increment double further, up to max_step, landing on the
+// nominal grid; a harder one brings it back to the nominal step. Below the minimum increment the
+// stepper gives up with an error naming the time and the increment.
 #pragma once
 
 #include <stdexcept>
@@ -29,7 +32,8 @@ class LoadStepper {
   double increment() const { return dt_; }
   int cuts() const { return cuts_; }            // cuts of the current step so far
 
-  void accept();
+  // iterations: what the accepted step needed (coupling or Newton iterations; adaptive steps).
+  void accept(int iterations);
   // Halves the increment; throws StepFailure (with `reason`) when it would fall below min_step.
   void reject(const std::string& reason);
 

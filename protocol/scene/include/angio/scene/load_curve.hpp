@@ -50,6 +50,14 @@ struct TimeSettings {
   int steps = 1;
   double min_step = 0.0;  // smallest step the stepper may cut down to (default: initial/1024)
   int max_cuts = 10;
+  // Adaptive steps (time.adaptive; off: max_step = 0): after a step that needed at most
+  // easy_iterations iterations (coupling iterations, or Newton iterations of a participant alone)
+  // the increment doubles, up to max_step; after a harder step it is the nominal one again.
+  double max_step = 0.0;
+  int easy_iterations = 1;
+  // Times no step crosses: the corners of the load curves inside (start, end), sorted. A larger
+  // step lands on them (and on the nominal grid), so a peak of a curve is always hit exactly.
+  std::vector<double> stops;
 };
 TimeSettings time_settings(const Node& root);
 
