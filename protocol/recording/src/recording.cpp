@@ -1,5 +1,6 @@
 #include "angio/recording/recording.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -21,6 +22,7 @@ void put_bytes(std::ofstream& o, const void* p, std::uint32_t n) {
 struct In {
   std::ifstream in;
   std::string path;
+  std::uint64_t size = 0;  // of the file: no length field may ask for more than what is left
   template <class T>
   T get() {
     T v{};
@@ -28,6 +30,12 @@ struct In {
     return v;
   }
   std::vector<std::uint8_t> bytes(std::uint32_t n) {
+    // checked before allocating: a corrupted length (e.g. 0xFFFFFFFF) must not allocate 4 GiB
+    const auto at = static_cast<std::uint64_t>(in.tellg());
+    if (n > size - std::min(at, size))
+      throw std::runtime_error(path + ": recording is corrupt or truncated: a length of " + std::to_string(n) +
+                               " bytes for the data at offset " + std::to_string(at) + " exceeds the " +
+                               std::to_string(size - std::min(at, size)) + " bytes left in the file");
     std::vector<std::uint8_t> b(n);
     if (n && !in.read(reinterpret_cast<char*>(b.data()), n)) truncated();
     return b;
@@ -61,6 +69,9 @@ void Recorder::add(fb::Role role, const std::string& verb, const msg::Buffer& re
 Recording read(const std::string& path) {
   In r{std::ifstream(path, std::ios::binary), path};
   if (!r.in) throw std::runtime_error(path + ": cannot open the recording");
+  r.in.seekg(0, std::ios::end);
+  r.size = static_cast<std::uint64_t>(r.in.tellg());
+  r.in.seekg(0, std::ios::beg);
   char magic[8];
   if (!r.in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0)
     throw std::runtime_error(path + ": not an angio recording (bad magic)");
@@ -72,7 +83,12 @@ Recording read(const std::string& path) {
   rec.run_id.assign(id.begin(), id.end());
   while (r.in.peek() != std::char_traits<char>::eof()) {
     Exchange e;
-    e.role = static_cast<fb::Role>(r.get<std::uint8_t>());
+    const auto role = r.get<std::uint8_t>();
+    if (role > static_cast<std::uint8_t>(fb::Role::MAX))
+      throw std::runtime_error(path + ": recording is corrupt: exchange " + std::to_string(rec.exchanges.size()) +
+                               " has role " + std::to_string(role) + " (expected 0 to " +
+                               std::to_string(static_cast<int>(fb::Role::MAX)) + ")");
+    e.role = static_cast<fb::Role>(role);
     auto verb = r.bytes(r.get<std::uint16_t>());
     e.verb.assign(verb.begin(), verb.end());
     e.request = r.bytes(r.get<std::uint32_t>());

@@ -127,7 +127,15 @@ void ReplaySolid::begin_step(int step, double time) {
 participant::SolveStats ReplaySolid::solve(const participant::SamplePoints& pts,
                                            participant::ContactReply& reply, double tolerance) {
   const auto& req = *cursor_.next(fb::Payload::SolidSolveRequest).payload_as_SolidSolveRequest();
-  check_vectors(cursor_, "sample-point positions", pts.x, msg::to_sample_points(req.sample_points()).x, tol_);
+  const participant::SamplePoints rec = msg::to_sample_points(req.sample_points());
+  check_vectors(cursor_, "sample-point positions", pts.x, rec.x, tol_);
+  if (pts.w.size() != rec.w.size() || pts.radius.size() != rec.radius.size())
+    throw ReplayMismatch("exchange " + std::to_string(cursor_.position() - 1) + ": " + std::to_string(pts.w.size()) +
+                         " sample-point weights/radii but the recording has " + std::to_string(rec.w.size()));
+  for (std::size_t i = 0; i < rec.w.size(); ++i) {
+    check_scalar(cursor_, "sample-point weight", pts.w[i], rec.w[i], tol_);
+    check_scalar(cursor_, "sample-point radius", pts.radius[i], rec.radius[i], tol_);
+  }
   check_scalar(cursor_, "solve tolerance", tolerance, req.tolerance(), tol_);
   const auto& r = msg::payload_as<fb::SolidSolveReply>(cursor_.reply());
   reply = msg::to_contact(r);
