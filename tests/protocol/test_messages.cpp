@@ -1,8 +1,11 @@
 // Message round trips and rejection of malformed, foreign and old messages (issue 2, item 4).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "angio/messages/builders.hpp"
 #include "angio/messages/convert.hpp"
+#include "angio/messages/step_state.hpp"
 
 using namespace angio;
 using angio::msg::ProtocolError;
@@ -157,6 +160,13 @@ TEST(Messages, SequenceChecks) {
   seq.check_request(msg::open(d, "run-A"));
   EXPECT_NO_THROW(seq.check_reply(msg::open(d, "run-A"), 6));
   EXPECT_THROW(seq.check_reply(msg::open(d, "run-A"), 7), ProtocolError);
+  // a forged number far ahead is refused and does not lock the real requester out
+  auto forged = msg::ack(coupler(~std::uint64_t{0}));
+  EXPECT_THROW(seq.check_request(msg::open(forged, "run-A")), ProtocolError);
+  auto e = msg::ack(coupler(7));
+  EXPECT_NO_THROW(seq.check_request(msg::open(e, "run-A")));
+  auto gap = msg::ack(coupler(7 + msg::Sequence::kWindow));  // a gap within the window
+  EXPECT_NO_THROW(seq.check_request(msg::open(gap, "run-A")));
 }
 
 TEST(Messages, MismatchedSamplePointArraysAreRejected) {
@@ -165,4 +175,41 @@ TEST(Messages, MismatchedSamplePointArraysAreRejected) {
   auto buf = msg::solid_solve_request(coupler(1), 1, 0, pts, 0.0);
   const auto& r = msg::payload_as<fb::SolidSolveRequest>(msg::open(buf, "run-A"));
   EXPECT_THROW(msg::to_sample_points(r.sample_points()), ProtocolError);
+}
+
+// The step protocol a participant accepts (msg::StepState): the regular order passes (a rejected
+// step begun again included); out of order, a non-finite time, or a request for another step is
+// refused and leaves the state unchanged (robustness against stray or forged requests).
+TEST(Messages, StepStateAcceptsTheProtocolOrderOnly) {
+  using angio::msg::StepState;
+  std::uint64_t n = 0;
+  auto ok = [&](StepState& s, const msg::Buffer& b) { s.check(msg::open(b, "run-A")); };
+  auto refused = [&](StepState& s, const msg::Buffer& b, const std::string& what) {
+    try {
+      s.check(msg::open(b, "run-A"));
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const ProtocolError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  participant::SamplePoints pts;
+  StepState s;
+  refused(s, msg::step_begin(coupler(++n), 1, 0.1, 0.1), "before Hello");
+  ok(s, msg::hello(coupler(++n), "test"));
+  refused(s, msg::step_end(coupler(++n), 1, true), "outside a step");
+  refused(s, msg::solid_solve_request(coupler(++n), 1, 0, pts, 0.0), "outside a step");
+  refused(s, msg::step_begin(coupler(++n), 1, std::nan(""), 0.1), "expected finite values");
+  refused(s, msg::step_begin(coupler(++n), 1, 0.1, -0.1), "increment >= 0");
+  EXPECT_FALSE(s.in_step());
+  ok(s, msg::step_begin(coupler(++n), 1, 0.1, 0.1));
+  refused(s, msg::step_begin(coupler(++n), 2, 0.2, 0.1), "while step 1 is open");
+  refused(s, msg::beam_solve_request(coupler(++n), 2, 0, {}), "while step 1 is open");
+  ok(s, msg::beam_solve_request(coupler(++n), 1, 0, {}));
+  ok(s, msg::solid_solve_request(coupler(++n), 1, 1, pts, 0.0));
+  refused(s, msg::step_end(coupler(++n), 2, false), "while step 1 is open");
+  ok(s, msg::step_end(coupler(++n), 1, false));  // rejected: the same step begins again, halved
+  ok(s, msg::step_begin(coupler(++n), 1, 0.05, 0.05));
+  ok(s, msg::step_end(coupler(++n), 1, true));
+  EXPECT_FALSE(s.in_step());
+  ok(s, msg::shutdown(coupler(++n), "done"));
 }

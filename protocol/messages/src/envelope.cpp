@@ -41,10 +41,11 @@ const fb::Envelope& open(std::span<const std::uint8_t> bytes, const std::string&
 }
 
 void Sequence::check_request(const fb::Envelope& env) {
-  if (env.sequence() <= last_received_)
+  if (env.sequence() <= last_received_ || env.sequence() - last_received_ > kWindow)
     throw ProtocolError("out-of-sequence " + std::string(payload_name(env.payload_type())) +
                         ": number " + std::to_string(env.sequence()) + " after " +
-                        std::to_string(last_received_));
+                        std::to_string(last_received_) + " (expected one of the next " +
+                        std::to_string(kWindow) + ")");
   last_received_ = env.sequence();
 }
 

@@ -8,6 +8,7 @@
 #include "angio/common/log.hpp"
 #include "angio/messages/builders.hpp"
 #include "angio/messages/convert.hpp"
+#include "angio/messages/step_state.hpp"
 #include "angio/participant/keys.hpp"
 #include "angio/transport.hpp"
 
@@ -35,6 +36,7 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
   LOG_DEBUG("serving " << keys::serve(o.run_id, name) << " via " << o.endpoint);
 
   msg::Sequence sequence;
+  msg::StepState state;
   bool coupler_seen = false;
   auto last_heard = Clock::now();
   for (;;) {
@@ -63,6 +65,7 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
       const fb::Envelope& env = msg::open(q->payload(), o.run_id);
       h.sequence = env.sequence();
       sequence.check_request(env);
+      state.check(env);
       q->reply(dispatch(env, h, stop));
     } catch (const std::exception& e) {
       // A bad message or a failing solver is answered with an Error; the coupler decides.

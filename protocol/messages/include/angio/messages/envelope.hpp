@@ -45,10 +45,12 @@ const T& payload_as(const fb::Envelope& env) {
 }
 
 // Sequence bookkeeping of one conversation. A receiver of requests accepts only strictly
-// increasing numbers (a replayed or reordered request is rejected); a requester accepts only a
-// reply carrying the number of the request it sent.
+// increasing numbers within a window above the last one (a replayed or reordered request is
+// rejected, and a forged number far ahead, e.g. 2^64 - 1, cannot lock the real requester out); a
+// requester accepts only a reply carrying the number of the request it sent.
 class Sequence {
  public:
+  static constexpr std::uint64_t kWindow = 1000;  // the coupler numbers its requests consecutively
   std::uint64_t next() { return ++last_sent_; }
   void check_request(const fb::Envelope& env);
   void check_reply(const fb::Envelope& env, std::uint64_t request_sequence) const;
