@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets up the machine, builds, and runs a scene (default: the straight free stent expansion of
-# the paper, §3.1: coupler + beam_solver + solid_solver, about 100 s on 2 cores after the build).
+# the paper, §3.1: coupler + beam_solver + solid_solver, about a minute on 2 cores after the build).
 #   scripts/run.sh [SCENE] [launcher options, see scripts/launch.py --help]
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
