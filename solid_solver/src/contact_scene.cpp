@@ -85,12 +85,10 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   }
   const bool log = spec.log;
   composite_.after_reply = [this, log](const SolidModel& m, const participant::ContactReply& reply) {
-    const double total = contact_seconds();
-    const double dt_contact = total - contact_seconds_at_last_;
-    contact_seconds_at_last_ = total;
-    const double dt_solve = runner_.last_report().total_seconds;
-    solve_seconds_ += dt_solve;
     if (!log || m.rank() != 0) return;
+    // the solve's own split (SolveReport): contact add() inside its assemblies only
+    const double dt_contact = runner_.last_report().contact_seconds;
+    const double dt_solve = runner_.last_report().total_seconds;
     std::ostringstream os;
     os << std::setprecision(4) << "contact t=" << m.time();
     if (stent_ && stent_->num_points() > 0)
@@ -117,13 +115,6 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
 ContactSetup::~ContactSetup() {
   runner_.set_stent_contact(nullptr);
   runner_.clear_contact_reports();
-}
-
-double ContactSetup::contact_seconds() const {
-  double s = 0.0;
-  if (stent_) s += stent_->timing().seconds;
-  if (balloon_artery_) s += balloon_artery_->timing().seconds;
-  return s;
 }
 
 std::unique_ptr<ContactSetup> make_contact(const Node& root, SolidRunner& runner) {

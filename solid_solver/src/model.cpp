@@ -478,12 +478,21 @@ SolveReport SolidModel::solve(double loose_atol) {
   double res = norm(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
+  auto converged = [&](double r, int it) { return r <= atol || (it > 0 && r <= no.rtol * res0); };
   rep.residual_history.push_back(res);
   std::vector<double> du_full, u_base;
+  // Modified Newton: the old factorization failed or diverged at this iterate; the next iteration
+  // factorizes the tangent here (the residual is unchanged, recorded again for the iteration count).
+  auto current_tangent = [&] {
+    if (!assemble_here(true)) return false;
+    fresh = true;
+    rep.residual_history.push_back(res);
+    return true;
+  };
   for (int it = 0;; ++it) {
     rep.iterations = it;
     rep.residual = res;
-    if (res <= atol || (it > 0 && res <= no.rtol * res0)) {
+    if (converged(res, it)) {
       rep.converged = true;
       rep.message = "converged";
       if (damping_diag_) rep.damping_force = damping_(nullptr, nullptr);
@@ -518,9 +527,7 @@ SolveReport SolidModel::solve(double loose_atol) {
       pc_current_ = reason > 0 || reason == KSP_DIVERGED_ITS;
       if (reuse && reason < 0) {  // the old factorization no longer serves: the current tangent instead
         rep.linear_seconds += MPI_Wtime() - t0;
-        if (!assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
-        fresh = true;
-        rep.residual_history.push_back(res);
+        if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it));
         continue;
       }
     } else {
@@ -565,9 +572,7 @@ SolveReport SolidModel::solve(double loose_atol) {
     }
     if (stale && !(new_res < res)) {  // the old factorization diverges here: back, and the current tangent
       u_ = u_base;
-      if (!assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
-      fresh = true;
-      rep.residual_history.push_back(res);
+      if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it));
       continue;
     }
     if (!accepted && !stale) {
@@ -584,7 +589,7 @@ SolveReport SolidModel::solve(double loose_atol) {
     if (modified) {
       // keep the factorization while it contracts fast enough; otherwise the tangent here, for the
       // next iteration (the residual is assembled again with it)
-      fresh = !(new_res <= no.max_contraction * res) && new_res > atol && !(new_res <= no.rtol * res0);
+      fresh = !(new_res <= no.max_contraction * res) && !converged(new_res, it + 1);
       if (fresh && !assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
     }
     res = new_res;

@@ -231,6 +231,8 @@ TEST(CouplingLoop, InexactSolidToleranceFollowsTheCouplingResidual) {
     }
     EXPECT_EQ(solve, wall.tolerances.size());
     EXPECT_GT(solve, reports.size());  // some step iterates, so some tolerance follows a residual
-    if (eta > 0) EXPECT_GT(wall.tolerances.back(), 0.0);
+    if (eta > 0) {
+      EXPECT_GT(wall.tolerances.back(), 0.0);
+    }
   }
 }

@@ -179,7 +179,8 @@ TEST(Messages, MismatchedSamplePointArraysAreRejected) {
 
 // The step protocol a participant accepts (msg::StepState): the regular order passes (a rejected
 // step begun again included); out of order, a non-finite time, or a request for another step is
-// refused and leaves the state unchanged (robustness against stray or forged requests).
+// refused and leaves the state unchanged, as is a solid solve request with a NaN or negative
+// tolerance (robustness against stray or forged requests).
 TEST(Messages, StepStateAcceptsTheProtocolOrderOnly) {
   using angio::msg::StepState;
   std::uint64_t n = 0;
@@ -206,6 +207,8 @@ TEST(Messages, StepStateAcceptsTheProtocolOrderOnly) {
   refused(s, msg::beam_solve_request(coupler(++n), 2, 0, {}), "while step 1 is open");
   ok(s, msg::beam_solve_request(coupler(++n), 1, 0, {}));
   ok(s, msg::solid_solve_request(coupler(++n), 1, 1, pts, 0.0));
+  refused(s, msg::solid_solve_request(coupler(++n), 1, 2, pts, std::nan("")), "expected a finite value >= 0");
+  refused(s, msg::solid_solve_request(coupler(++n), 1, 2, pts, -1e-3), "expected a finite value >= 0");
   refused(s, msg::step_end(coupler(++n), 2, false), "while step 1 is open");
   ok(s, msg::step_end(coupler(++n), 1, false));  // rejected: the same step begins again, halved
   ok(s, msg::step_begin(coupler(++n), 1, 0.05, 0.05));

@@ -34,9 +34,11 @@ std::string error_of(const std::string& p) {
   return "";
 }
 
-// A recording of two exchanges; returns its path.
+// A recording of two exchanges, in a file of the running test's own (ctest runs the tests of this
+// file in parallel processes); returns its path.
 std::string two_exchanges() {
-  const std::string p = temp_path("two.angiorec");
+  const std::string p =
+      temp_path((std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + ".angiorec").c_str());
   recording::Recorder r(p, "run-A");
   r.add(fb::Role::Beam, "solve", msg::Buffer{1, 2, 3}, msg::Buffer{4, 5});
   r.add(fb::Role::Solid, "step_end", msg::Buffer{}, msg::Buffer{6});

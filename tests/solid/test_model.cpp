@@ -42,6 +42,23 @@ SurfaceSet faces_at_x1(const Mesh& m) {
   return right;
 }
 
+// Nodal displacements of a model (all ranks hold them), by mesh node.
+std::vector<Vec3d> displacements(const SolidModel& model) {
+  std::vector<Vec3d> u;
+  for (size_t n = 0; n < model.mesh().X.size(); ++n) u.push_back(model.displacement(int(n)));
+  return u;
+}
+double max_norm(const std::vector<Vec3d>& a) {
+  double d = 0.0;
+  for (const auto& v : a) d = std::max(d, v.norm());
+  return d;
+}
+double max_diff(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+  double d = 0.0;
+  for (size_t n = 0; n < a.size(); ++n) d = std::max(d, (a[n] - b[n]).norm());
+  return d;
+}
+
 ModelOptions direct_options() {
   ModelOptions o;
   o.petsc_options = "-ksp_rtol 1e-12";
@@ -139,14 +156,7 @@ TEST(Model, DampingConvergesToTheEquilibrium) {
       max_newton = std::max(max_newton, rep.iterations);
       model->commit();
     }
-    std::vector<Vec3d> u;
-    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model->displacement(int(n)));
-    return u;
-  };
-  auto max_diff = [](const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
-    double d = 0.0;
-    for (size_t n = 0; n < a.size(); ++n) d = std::max(d, (a[n] - b[n]).norm());
-    return d;
+    return displacements(*model);
   };
   std::vector<double> f0, f;
   int it0 = 0, it = 0;
@@ -191,20 +201,14 @@ TEST(Model, ReusedPreconditionerGivesTheSameSolution) {
       setups += rep.factorizations;
       model->commit();
     }
-    std::vector<Vec3d> u;
-    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model->displacement(int(n)));
-    return u;
+    return displacements(*model);
   };
   int n0, s0, n1, s1;
   const auto u0 = run("-ksp_type preonly -pc_type lu", 0, n0, s0);
   const auto u1 = run("-ksp_type gmres -ksp_rtol 1e-12 -pc_type lu", 10, n1, s1);
-  double scale = 0.0, diff = 0.0;
-  for (size_t n = 0; n < u0.size(); ++n) {
-    scale = std::max(scale, u0[n].norm());
-    diff = std::max(diff, (u0[n] - u1[n]).norm());
-  }
+  const double scale = max_norm(u0);
   EXPECT_GT(scale, 0.05);
-  EXPECT_LT(diff, 1e-9 * scale);
+  EXPECT_LT(max_diff(u0, u1), 1e-9 * scale);
   EXPECT_EQ(s0, n0);  // one factorization per Newton iteration without reuse
   EXPECT_LT(s1, n1);
   EXPECT_LE(n1, n0 + 1);
@@ -237,23 +241,16 @@ TEST(Model, ModifiedNewtonGivesTheSameSolutionWithFewerFactorizations) {
       tot.add(rep);
       model->commit();
     }
-    std::vector<Vec3d> u;
-    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model->displacement(int(n)));
-    return u;
+    return displacements(*model);
   };
   SolveTotals exact, mod, strict;
   const auto u0 = run(false, 0.25, exact);
   const auto u1 = run(true, 0.5, mod);
   const auto u2 = run(true, 1e-12, strict);
-  double scale = 0.0, d1 = 0.0, d2 = 0.0;
-  for (size_t n = 0; n < u0.size(); ++n) {
-    scale = std::max(scale, u0[n].norm());
-    d1 = std::max(d1, (u0[n] - u1[n]).norm());
-    d2 = std::max(d2, (u0[n] - u2[n]).norm());
-  }
+  const double scale = max_norm(u0);
   EXPECT_GT(scale, 0.05);
-  EXPECT_LT(d1, 1e-9 * scale);
-  EXPECT_LT(d2, 1e-9 * scale);
+  EXPECT_LT(max_diff(u0, u1), 1e-9 * scale);
+  EXPECT_LT(max_diff(u0, u2), 1e-9 * scale);
   EXPECT_EQ(exact.factorizations, exact.newton_iterations);
   EXPECT_LT(mod.factorizations, 8);  // fewer than one per step
   EXPECT_GT(mod.newton_iterations, exact.newton_iterations);  // linear instead of quadratic convergence
@@ -271,21 +268,11 @@ TEST(Model, ModifiedNewtonGivesTheSameSolutionWithFewerFactorizations) {
 TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
   const double p = 0.05, beta = 0.3;
   const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
-  auto disp = [&](SolidModel& model) {
-    std::vector<Vec3d> u;
-    for (size_t n = 0; n < m.X.size(); ++n) u.push_back(model.displacement(int(n)));
-    return u;
-  };
-  auto max_diff = [](const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
-    double d = 0.0;
-    for (size_t n = 0; n < a.size(); ++n) d = std::max(d, (a[n] - b[n]).norm());
-    return d;
-  };
   auto elastic = [&](double scale) {
     auto model = pressed_cube(m, LayerMaterial{"cube", {2.0 * scale, 0.3}, {{0.4 * scale, 1.5, 20.0, true}}},
                               direct_options(), p);
     EXPECT_TRUE(model->solve().converged);
-    return disp(*model);
+    return displacements(*model);
   };
   const auto u_inf = elastic(1.0), u_0 = elastic(1.0 + beta);
   double scale = 0;
@@ -296,7 +283,7 @@ TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
   model->start_at(0.0);
   model->set_time(1e-10);
   ASSERT_TRUE(model->solve().converged);
-  EXPECT_LT(max_diff(disp(*model), u_0), 1e-8 * scale);
+  EXPECT_LT(max_diff(displacements(*model), u_0), 1e-8 * scale);
   model->commit();
 
   double t = 1e-10, previous = 0.0;
@@ -305,18 +292,18 @@ TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
     model->set_time(t);
     ASSERT_TRUE(model->solve().converged);
     if (i == 3) {  // reject once and solve the same step again
-      const auto first = disp(*model);
+      const auto first = displacements(*model);
       model->rollback();
       ASSERT_TRUE(model->solve().converged);
-      EXPECT_LT(max_diff(disp(*model), first), 1e-12 * scale);
+      EXPECT_LT(max_diff(displacements(*model), first), 1e-12 * scale);
     }
     model->commit();
-    const double d = max_diff(disp(*model), u_0);
+    const double d = max_diff(displacements(*model), u_0);
     EXPECT_GE(d, previous - 1e-14);  // creeps away from the instantaneous response, monotonically
     previous = d;
   }
   // 10 s = 15 retardation times τ(1 + β) of the linearized model: e^(−15) ≈ 3e-7
-  EXPECT_LT(max_diff(disp(*model), u_inf), 1e-5 * scale);
+  EXPECT_LT(max_diff(displacements(*model), u_inf), 1e-5 * scale);
   EXPECT_GT(max_diff(u_0, u_inf), 0.1 * scale);  // the two limits are far apart
 }
 
@@ -383,15 +370,13 @@ TEST(Model, OneAndTwoRanksGiveSameDisplacements) {
     model.add_pressure({"artery_inner", [](double t) { return 0.03 * t; }});
     model.add_springs({"artery_end0", 1e3});
     model.add_springs({"artery_end1", 1e3});
-    std::vector<Vec3d> u(m.X.size());
     for (double t : {0.5, 1.0}) {
       model.set_time(t);
       const auto rep = model.solve();
       EXPECT_TRUE(rep.converged) << rep.message;
       model.commit();
     }
-    for (size_t n = 0; n < m.X.size(); ++n) u[n] = model.displacement(int(n));
-    return u;
+    return displacements(model);
   };
   const auto u_par = run(PETSC_COMM_WORLD, "contiguous");
   const auto u_part = run(PETSC_COMM_WORLD, "ptscotch");
@@ -399,15 +384,10 @@ TEST(Model, OneAndTwoRanksGiveSameDisplacements) {
   MPI_Comm_split(PETSC_COMM_WORLD, world_rank() == 0 ? 0 : MPI_UNDEFINED, 0, &serial);
   if (world_rank() == 0) {
     const auto u_ser = run(serial, "contiguous");
-    double umax = 0, d1 = 0, d2 = 0;
-    for (size_t n = 0; n < u_ser.size(); ++n) {
-      umax = std::max(umax, u_ser[n].norm());
-      d1 = std::max(d1, (u_ser[n] - u_par[n]).norm());
-      d2 = std::max(d2, (u_ser[n] - u_part[n]).norm());
-    }
+    const double umax = max_norm(u_ser);
     EXPECT_GT(umax, 0.01);
-    EXPECT_LT(d1, 1e-8 * umax);
-    EXPECT_LT(d2, 1e-8 * umax);
+    EXPECT_LT(max_diff(u_ser, u_par), 1e-8 * umax);
+    EXPECT_LT(max_diff(u_ser, u_part), 1e-8 * umax);
     MPI_Comm_free(&serial);
   }
 }

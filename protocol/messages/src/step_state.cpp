@@ -37,7 +37,14 @@ void StepState::check(const fb::Envelope& env) {
       return;
     }
     case fb::Payload::BeamSolveRequest: in_this_step(env.payload_as_BeamSolveRequest()->step()); return;
-    case fb::Payload::SolidSolveRequest: in_this_step(env.payload_as_SolidSolveRequest()->step()); return;
+    case fb::Payload::SolidSolveRequest: {
+      const auto& r = *env.payload_as_SolidSolveRequest();
+      in_this_step(r.step());
+      if (!std::isfinite(r.tolerance()) || r.tolerance() < 0.0)
+        throw ProtocolError("SolidSolveRequest with tolerance " + std::to_string(r.tolerance()) +
+                            " (expected a finite value >= 0)");
+      return;
+    }
     case fb::Payload::StepEnd:
       in_this_step(env.payload_as_StepEnd()->step());
       open_ = false;

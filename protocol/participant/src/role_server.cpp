@@ -1,7 +1,6 @@
 #include "angio/participant/role_server.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <functional>
 
 #include "angio/common/clock.hpp"
@@ -161,10 +160,7 @@ int serve(SolidParticipant& solid, const ServeOptions& o) {
         SamplePoints pts = msg::to_sample_points(r.sample_points());
         ContactReply reply;
         const auto t0 = Clock::now();
-        const double tol = r.tolerance();
-        if (!(std::isfinite(tol) && tol >= 0.0))
-          throw msg::ProtocolError("SolidSolveRequest carries tolerance " + std::to_string(tol) + " (expected a finite value >= 0)");
-        SolveStats stats = solid.solve(pts, reply, tol);
+        SolveStats stats = solid.solve(pts, reply, r.tolerance());  // checked by msg::StepState
         return msg::solid_solve_reply(h, stats, seconds_since(t0), reply);
       }
       case fb::Payload::StepEnd:

@@ -39,7 +39,8 @@ struct RunReport {
   int max_iterations = 0;
   int rejected_attempts = 0;
   double wall_time = 0.0;
-  double beam_time = 0.0;   // s in solves over every attempt, rejected steps included
+  // s in solves over every attempt, rejected steps included
+  double beam_time = 0.0;
   double solid_time = 0.0;
 };
 

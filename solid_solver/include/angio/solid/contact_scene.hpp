@@ -47,18 +47,12 @@ class ContactSetup {
   PenaltyStentContact* stent() { return stent_.get(); }
   PenaltySurfaceContact* balloon_artery() { return balloon_artery_.get(); }
   CompositeContact& composite() { return composite_; }
-  // Seconds spent in contact add() (search + evaluation + insertion) over all assemblies so far.
-  double contact_seconds() const;
-  // Sum of SolveReport::total_seconds of the converged solves seen by the reply hook.
-  double solve_seconds() const { return solve_seconds_; }
 
  private:
   SolidRunner& runner_;
   std::unique_ptr<PenaltyStentContact> stent_;
   std::unique_ptr<PenaltySurfaceContact> balloon_artery_;
   CompositeContact composite_;
-  double solve_seconds_ = 0.0;
-  double contact_seconds_at_last_ = 0.0;
 };
 
 // Reads the `contact:` section and builds/registers the contact of a runner. Collective (all ranks).

@@ -1,5 +1,6 @@
 // The order of requests a participant accepts (DESIGN §2): Hello first; then per load step a
-// StepBegin (finite time and increment), solve requests for that step, and a StepEnd for that step;
+// StepBegin (finite time and increment), solve requests for that step (a solid's with a finite
+// tolerance >= 0), and a StepEnd for that step;
 // Shutdown at any time. A request out of this order is refused with a ProtocolError (the role server
 // answers it with an Error) and leaves the state as it was, so a stray or forged request cannot
 // commit, roll back or solve anything.
