@@ -1,12 +1,17 @@
 #include "angio/solid/mesh.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <numbers>
-#include <sstream>
+#include <optional>
 #include <stdexcept>
+#include <string_view>
 #include <unordered_map>
 
 namespace angio::solid {
@@ -249,217 +254,274 @@ Mesh make_tube(const TubeSpec& s) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// gmsh reader
+// gmsh reader: MSH 4.1, ASCII and binary (gmsh reference manual, "MSH file format", version 4.1).
+// One parser serves both encodings: the sections have the same fields in the same order, only the
+// encoding of a number differs (a text token, or the raw int / size_t / double in the binary
+// file), so the section readers below read fields through MshInput::value<T> and never look at
+// the encoding themselves. GmshMeshBuilder is the one place that turns them into the Mesh.
 namespace {
-struct Reader {
-  std::ifstream in;
-  std::string path;
-  int line = 0;
-  std::istringstream ls;
-  [[noreturn]] void fail(const std::string& msg) const {
-    throw std::runtime_error(path + ":" + std::to_string(line) + ": " + msg);
+
+// Counts and sizes read from the file are bounded by this and by the bytes left in the file.
+constexpr uint64_t kMaxCount = uint64_t(std::numeric_limits<int>::max());  // Mesh indices are int
+
+// The values one record of a section holds at least, to bound a count by the bytes left before
+// allocating: in a binary file an int takes 4 bytes, a size_t and a double (data-size) 8; in an
+// ASCII file every value takes at least one character and one separator.
+struct Record {
+  uint64_t ints = 0, sizes = 0, doubles = 0;
+};
+
+class MshInput {
+ public:
+  explicit MshInput(const std::string& path) : path_(path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error(path + ": cannot open mesh file");
+    buf_.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    if (f.bad()) throw std::runtime_error(path + ": read error");
   }
-  bool next() {
-    std::string s;
-    while (std::getline(in, s)) {
-      ++line;
-      if (!s.empty() && s.back() == '\r') s.pop_back();
-      if (s.find_first_not_of(" \t") == std::string::npos) continue;
-      ls.clear();
-      ls.str(s);
-      return true;
+  // From the line after the header of $MeshFormat on, numbers are binary in a binary file.
+  void set_binary(bool b) { binary_ = binary_file_ = b; }
+  // $PhysicalNames is ASCII even in a binary file (gmsh writes it so; manual, MSH 4.1).
+  struct AsciiScope {
+    explicit AsciiScope(MshInput& in) : in_(in), saved_(in.binary_) { in.binary_ = false; }
+    ~AsciiScope() { in_.binary_ = saved_; }
+    MshInput& in_;
+    bool saved_;
+  };
+
+  [[noreturn]] void fail_at(size_t at, const std::string& msg) const {
+    if (binary_file_) throw std::runtime_error(path_ + ": " + msg + " at byte offset " + std::to_string(at));
+    throw std::runtime_error(path_ + ":" + std::to_string(line_of(at)) + ": " + msg);
+  }
+  [[noreturn]] void fail(const std::string& msg) const { fail_at(pos_, msg); }
+
+  // Next section header "$Name" (lines outside sections are ignored, as gmsh does); false at the end.
+  bool next_section(std::string& name) {
+    while (skip_space()) {
+      name = line();
+      if (name.size() > 1 && name[0] == '$') return true;
     }
     return false;
   }
-  std::string word() {
-    std::string w;
-    if (!(ls >> w)) fail("unexpected end of line");
-    return w;
+  // The "$EndName" line closing the section just read.
+  void end_section(const std::string& end) {
+    const size_t at = pos_;
+    const std::string found = skip_space() ? line() : std::string("end of file");
+    if (found != end) fail_at(at, "expected " + end + ", found '" + printable(found) + "'");
+  }
+  // Skips an unknown section $Name up to its "$EndName" line (at a line start; gmsh skips such
+  // sections line by line, which also passes over their binary data).
+  void skip_section(const std::string& name) {
+    const std::string end = "\n$End" + name.substr(1);
+    const size_t at = buf_.find(end, pos_ - 1);  // pos_ >= 1: just after the header's newline
+    if (at == std::string::npos) fail("section " + name + " has no $End" + name.substr(1));
+    pos_ = at + 1;
+    line();
+  }
+  // Rest of the current line (the newline is consumed).
+  void skip_line() { line(); }
+
+  template <class T>
+  T value(const char* what) {
+    return binary_ ? raw<T>(what) : text<T>(what);
+  }
+  // A count of records that follow: checked against the bytes left before anyone allocates.
+  uint64_t count(const char* what, const Record& per_record) {
+    const size_t at = pos_;
+    const uint64_t n = value<uint64_t>(what);
+    const uint64_t bytes = binary_ ? 4 * per_record.ints + 8 * (per_record.sizes + per_record.doubles)
+                                   : 2 * (per_record.ints + per_record.sizes + per_record.doubles);
+    const uint64_t left = buf_.size() - pos_;
+    if (n > kMaxCount || (bytes > 0 && n > left / bytes))
+      fail_at(at, std::string(what) + " = " + std::to_string(n) + " does not fit in the " + std::to_string(left) +
+                      " bytes left in the file (corrupted or truncated)");
+    return n;
+  }
+  // Skips n values of the given kind (bounded by count() before).
+  void skip(const Record& r, uint64_t n) {
+    for (uint64_t i = 0; i < n * r.ints; ++i) value<int32_t>("int");
+    for (uint64_t i = 0; i < n * r.sizes; ++i) value<uint64_t>("size");
+    for (uint64_t i = 0; i < n * r.doubles; ++i) value<double>("double");
+  }
+  // The next whitespace-separated word (ASCII).
+  std::string_view token(const char* what) {
+    if (!skip_space()) fail(std::string("unexpected end of file, expected ") + what);
+    const size_t at = pos_;
+    while (pos_ < buf_.size() && !space(buf_[pos_])) ++pos_;
+    return std::string_view(buf_).substr(at, pos_ - at);
+  }
+  // "name" up to the last quote of the line ($PhysicalNames).
+  std::string quoted(const char* what) {
+    skip_space();
+    const size_t eol = std::min(buf_.find('\n', pos_), buf_.size());
+    const size_t close = buf_.rfind('"', eol - 1);
+    if (pos_ >= buf_.size() || buf_[pos_] != '"' || close == std::string::npos || close <= pos_)
+      fail(std::string("expected a quoted ") + what);
+    std::string s = buf_.substr(pos_ + 1, close - pos_ - 1);
+    pos_ = close + 1;
+    return s;
+  }
+
+ private:
+  static bool space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+  bool skip_space() {
+    while (pos_ < buf_.size() && space(buf_[pos_])) ++pos_;
+    return pos_ < buf_.size();
+  }
+  std::string line() {
+    const size_t eol = std::min(buf_.find('\n', pos_), buf_.size());
+    std::string s = buf_.substr(pos_, eol - pos_);
+    pos_ = std::min(eol + 1, buf_.size());
+    while (!s.empty() && space(s.back())) s.pop_back();
+    return s;
+  }
+  size_t line_of(size_t at) const {
+    return 1 + size_t(std::count(buf_.begin(), buf_.begin() + std::min(at, buf_.size()), '\n'));
+  }
+  static std::string printable(const std::string& s) {
+    std::string out;
+    for (char c : s.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';
+    return out;
   }
   template <class T>
-  T get(const char* what) {
+  T raw(const char* what) {
+    if (buf_.size() - pos_ < sizeof(T)) fail(std::string("unexpected end of file, expected ") + what);
     T v;
-    if (!(ls >> v)) fail(std::string("expected ") + what);
+    std::memcpy(&v, buf_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
     return v;
   }
-  void need_next(const char* what) {
-    if (!next()) fail(std::string("unexpected end of file, expected ") + what);
+  template <class T>
+  T text(const char* what) {
+    const std::string_view tok = token(what);
+    T v{};
+    const auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+    if (ec != std::errc() || p != tok.data() + tok.size())
+      fail_at(pos_ - tok.size(), std::string("expected ") + what + ", found '" + printable(std::string(tok)) + "'");
+    return v;
   }
-};
-}  // namespace
 
-Mesh read_gmsh(const std::string& path, const std::string& part, const std::string& prefix, double scale) {
-  Reader r;
-  r.path = path;
-  r.in.open(path);
-  if (!r.in) throw std::runtime_error(path + ": cannot open mesh file");
-  std::map<int, std::string> phys_names[4];
-  std::map<int, std::vector<int>> entity_phys[4];
-  std::unordered_map<long, int> node_index;
-  Mesh m;
-  std::map<int, int> block_of_phys;
-  std::map<int, int> surf_of_phys;
-  bool have_format = false;
-  while (r.next()) {
-    const std::string sec = r.word();
-    if (sec == "$MeshFormat") {
-      r.need_next("version");
-      const double ver = r.get<double>("version");
-      const int ft = r.get<int>("file type");
-      if (ver < 4.0 || ver >= 5.0) r.fail("unsupported msh version " + std::to_string(ver) + ", expected 4.x");
-      if (ft != 0) r.fail("binary msh files are not supported, expected ASCII (file-type 0)");
-      have_format = true;
-      r.need_next("$EndMeshFormat");
-    } else if (sec == "$PhysicalNames") {
-      r.need_next("count");
-      const int n = r.get<int>("number of physical names");
-      for (int i = 0; i < n; ++i) {
-        r.need_next("physical name");
-        const int dim = r.get<int>("dimension");
-        const int tag = r.get<int>("tag");
-        std::string rest;
-        std::getline(r.ls, rest);
-        const auto a = rest.find('"'), b = rest.rfind('"');
-        if (a == std::string::npos || b == a) r.fail("expected quoted physical name");
-        if (dim >= 0 && dim <= 3) phys_names[dim][tag] = rest.substr(a + 1, b - a - 1);
-      }
-      r.need_next("$EndPhysicalNames");
-    } else if (sec == "$Entities") {
-      r.need_next("entity counts");
-      int cnt[4];
-      for (int d = 0; d < 4; ++d) cnt[d] = r.get<int>("entity count");
-      for (int d = 0; d < 4; ++d)
-        for (int i = 0; i < cnt[d]; ++i) {
-          r.need_next("entity");
-          const int tag = r.get<int>("entity tag");
-          for (int k = 0; k < (d == 0 ? 3 : 6); ++k) r.get<double>("bounding box");
-          const int np = r.get<int>("number of physical tags");
-          for (int k = 0; k < np; ++k) entity_phys[d][tag].push_back(std::abs(r.get<int>("physical tag")));
-        }
-      r.need_next("$EndEntities");
-    } else if (sec == "$Nodes") {
-      r.need_next("node header");
-      const long nblocks = r.get<long>("numEntityBlocks");
-      r.get<long>("numNodes");
-      for (long b = 0; b < nblocks; ++b) {
-        r.need_next("node block");
-        r.get<int>("entityDim");
-        r.get<int>("entityTag");
-        const int param = r.get<int>("parametric");
-        const long n = r.get<long>("numNodesInBlock");
-        std::vector<long> tags(n);
-        for (long i = 0; i < n; ++i) {
-          r.need_next("node tag");
-          tags[i] = r.get<long>("node tag");
-        }
-        for (long i = 0; i < n; ++i) {
-          r.need_next("node coordinates");
-          Vec3d x;
-          x.x() = r.get<double>("x");
-          x.y() = r.get<double>("y");
-          x.z() = r.get<double>("z");
-          (void)param;
-          node_index[tags[i]] = int(m.X.size());
-          m.X.push_back(scale * x);
-        }
-      }
-      r.need_next("$EndNodes");
-    } else if (sec == "$Elements") {
-      r.need_next("element header");
-      const long nblocks = r.get<long>("numEntityBlocks");
-      r.get<long>("numElements");
-      for (long b = 0; b < nblocks; ++b) {
-        r.need_next("element block");
-        const int dim = r.get<int>("entityDim");
-        const int etag = r.get<int>("entityTag");
-        const int gtype = r.get<int>("elementType");
-        const long n = r.get<long>("numElementsInBlock");
-        int nn = 0;
-        bool vol = false;
-        ElemType et = ElemType::Hex8;
-        FaceType ft = FaceType::Quad4;
-        switch (gtype) {
-          case 5: nn = 8; vol = true; et = ElemType::Hex8; break;
-          case 4: nn = 4; vol = true; et = ElemType::Tet4; break;
-          case 11: nn = 10; vol = true; et = ElemType::Tet10; break;
-          case 3: nn = 4; ft = FaceType::Quad4; break;
-          case 2: nn = 3; ft = FaceType::Tri3; break;
-          case 9: nn = 6; ft = FaceType::Tri6; break;
-          default: nn = -1;
-        }
-        const auto& phys = entity_phys[std::clamp(dim, 0, 3)][etag];
-        for (long i = 0; i < n; ++i) {
-          r.need_next("element");
-          if (nn < 0 || (vol && dim != 3) || (!vol && dim != 2)) continue;
-          r.get<long>("element tag");
-          std::array<int, 10> nodes{};
-          for (int a = 0; a < nn; ++a) {
-            const long t = r.get<long>("node tag");
-            const auto it = node_index.find(t);
-            if (it == node_index.end()) r.fail("unknown node tag " + std::to_string(t));
-            nodes[a] = it->second;
-          }
-          if (vol) {
-            std::vector<int> groups = phys;
-            if (groups.empty()) groups.push_back(-etag);  // no physical group: block per entity
-            const int g = groups.front();
-            auto bit = block_of_phys.find(g);
-            if (bit == block_of_phys.end()) {
-              std::string bname = g > 0 && phys_names[3].count(g) ? phys_names[3][g]
-                                                                  : "volume_" + std::to_string(std::abs(g));
-              bit = block_of_phys.emplace(g, int(m.blocks.size())).first;
-              m.blocks.push_back({bname, part});
-            }
-            Element e;
-            e.type = et;
-            e.block = bit->second;
-            e.n = nodes;
-            m.elements.push_back(e);
-          } else {
-            for (int g : phys) {
-              auto sit = surf_of_phys.find(g);
-              if (sit == surf_of_phys.end()) {
-                std::string sname = phys_names[2].count(g) ? phys_names[2][g] : "surface_" + std::to_string(g);
-                sit = surf_of_phys.emplace(g, int(m.surfaces.size())).first;
-                m.surfaces.push_back({prefix + sname, {}});
-              }
-              Face f;
-              f.type = ft;
-              for (int a = 0; a < nn; ++a) f.n[a] = nodes[a];
-              m.surfaces[sit->second].faces.push_back(f);
-            }
-          }
-        }
-      }
-      r.need_next("$EndElements");
-    } else if (!sec.empty() && sec[0] == '$' && sec.rfind("$End", 0) != 0) {
-      // skip unknown section
-      const std::string end = "$End" + sec.substr(1);
-      bool found = false;
-      while (r.next()) {
-        std::string w;
-        r.ls >> w;
-        if (w == end) {
-          found = true;
-          break;
-        }
-      }
-      if (!found) r.fail("missing " + end);
-    }
+  std::string path_, buf_;
+  size_t pos_ = 0;
+  bool binary_ = false, binary_file_ = false;
+};
+
+// Node counts of the gmsh element types (manual, "MSH file format": elm-type; the higher-order
+// types as gmsh 4.8's getElementProperties reports them); 0: unknown or variable (polygons), such
+// elements cannot be skipped in a binary file.
+int gmsh_node_count(int type) {
+  static constexpr int kNodes[67] = {
+      0,  2,  3,  4,  4,  8,  6,  5,  3,  6,  9,  10, 27, 18, 14, 1,  8,  20, 15, 13, 9,  10, 12,
+      15, 15, 21, 4,  5,  6,  20, 35, 56, 22, 28, 0,  0,  16, 25, 36, 12, 16, 20, 28, 36, 45, 55,
+      66, 49, 64, 81, 100, 121, 18, 21, 24, 27, 30, 24, 28, 32, 36, 40, 7,  8,  9,  10, 11};
+  if (type >= 0 && type < 67) return kNodes[type];
+  if (type == 92) return 64;   // hex64
+  if (type == 93) return 125;  // hex125
+  return 0;
+}
+
+// The element types the solver uses; a volume type counts in 3D entities only, a face type in 2D.
+struct GmshElement {
+  bool volume = false;
+  ElemType elem = ElemType::Hex8;
+  FaceType face = FaceType::Quad4;
+};
+std::optional<GmshElement> supported_element(int type, int entity_dim) {
+  std::optional<GmshElement> e;
+  switch (type) {
+    case 5: e = GmshElement{true, ElemType::Hex8, {}}; break;
+    case 4: e = GmshElement{true, ElemType::Tet4, {}}; break;
+    case 11: e = GmshElement{true, ElemType::Tet10, {}}; break;
+    case 3: e = GmshElement{false, {}, FaceType::Quad4}; break;
+    case 2: e = GmshElement{false, {}, FaceType::Tri3}; break;
+    case 9: e = GmshElement{false, {}, FaceType::Tri6}; break;
+    default: return std::nullopt;
   }
-  if (!have_format) throw std::runtime_error(path + ": not a gmsh file (no $MeshFormat)");
+  if (entity_dim != (e->volume ? 3 : 2)) return std::nullopt;
+  return e;
+}
+
+// Collects what the sections say and builds the Mesh: volume physical groups -> blocks, surface
+// physical groups -> surface sets (the same for ASCII and binary files).
+class GmshMeshBuilder {
+ public:
+  GmshMeshBuilder(std::string part, std::string prefix, double scale)
+      : part_(std::move(part)), prefix_(std::move(prefix)), scale_(scale) {}
+
+  void physical_name(int dim, int tag, std::string name) {
+    if (dim >= 0 && dim <= 3) names_[dim][tag] = std::move(name);
+  }
+  void entity_physical(int dim, int entity, int phys) { entity_phys_[dim][entity].push_back(std::abs(phys)); }
+  void node(uint64_t tag, const Vec3d& x) {
+    node_index_[tag] = int(m_.X.size());
+    m_.X.push_back(scale_ * x);
+  }
+  std::optional<int> node_index(uint64_t tag) const {
+    const auto it = node_index_.find(tag);
+    if (it == node_index_.end()) return std::nullopt;
+    return it->second;
+  }
+  // An element of a 3D entity (its first physical group, or a block per entity without one) or a
+  // face of a 2D entity (one copy per physical group of the entity).
+  void element(const GmshElement& t, int entity, const std::array<int, 10>& nodes) {
+    if (t.volume) {
+      Element e;
+      e.type = t.elem;
+      e.block = block_of(entity);
+      e.n = nodes;
+      m_.elements.push_back(e);
+      return;
+    }
+    Face f;
+    f.type = t.face;
+    for (int a = 0; a < f.nn(); ++a) f.n[a] = nodes[a];
+    for (int g : entity_phys_[2][entity]) m_.surfaces[surface_of(g)].faces.push_back(f);
+  }
+  Mesh finish(const std::string& path);
+
+ private:
+  int block_of(int entity) {
+    const auto& groups = entity_phys_[3][entity];
+    const int g = groups.empty() ? -entity : groups.front();  // negative: no physical group
+    auto it = block_of_phys_.find(g);
+    if (it == block_of_phys_.end()) {
+      const std::string name = g > 0 && names_[3].count(g) ? names_[3][g] : "volume_" + std::to_string(std::abs(g));
+      it = block_of_phys_.emplace(g, int(m_.blocks.size())).first;
+      m_.blocks.push_back({name, part_});
+    }
+    return it->second;
+  }
+  int surface_of(int g) {
+    auto it = surf_of_phys_.find(g);
+    if (it == surf_of_phys_.end()) {
+      const std::string name = names_[2].count(g) ? names_[2][g] : "surface_" + std::to_string(g);
+      it = surf_of_phys_.emplace(g, int(m_.surfaces.size())).first;
+      m_.surfaces.push_back({prefix_ + name, {}});
+    }
+    return it->second;
+  }
+
+  std::string part_, prefix_;
+  double scale_;
+  std::map<int, std::string> names_[4];
+  std::map<int, std::vector<int>> entity_phys_[4];
+  std::unordered_map<uint64_t, int> node_index_;
+  std::map<int, int> block_of_phys_, surf_of_phys_;
+  Mesh m_;
+};
+
+// Drops the nodes no volume element uses (geometry points etc.) and orients the surfaces.
+Mesh GmshMeshBuilder::finish(const std::string& path) {
+  Mesh m = std::move(m_);
   if (m.elements.empty()) throw std::runtime_error(path + ": no volume elements (hex8, tet4, tet10) found");
-  // drop unreferenced nodes (geometry points etc.)
   std::vector<int> used(m.X.size(), -1);
-  int cnt = 0;
   for (const auto& e : m.elements)
-    for (int a = 0; a < e.nn(); ++a)
-      if (used[e.n[a]] < 0) used[e.n[a]] = 0;
-  std::vector<Vec3d> X2;
+    for (int a = 0; a < e.nn(); ++a) used[e.n[a]] = 0;
+  std::vector<Vec3d> X;
   for (size_t i = 0; i < used.size(); ++i)
     if (used[i] == 0) {
-      used[i] = cnt++;
-      X2.push_back(m.X[i]);
+      used[i] = int(X.size());
+      X.push_back(m.X[i]);
     }
   for (auto& e : m.elements)
     for (int a = 0; a < e.nn(); ++a) e.n[a] = used[e.n[a]];
@@ -469,10 +531,156 @@ Mesh read_gmsh(const std::string& path, const std::string& part, const std::stri
         if (used[f.n[a]] < 0) throw std::runtime_error(path + ": surface " + s.name + " has nodes outside the volume mesh");
         f.n[a] = used[f.n[a]];
       }
-  m.X = std::move(X2);
-  // fix negative-Jacobian volume elements by reporting them
+  m.X = std::move(X);
   m.orient_surfaces();
   return m;
+}
+
+int entity_dim(MshInput& in) {
+  const int d = in.value<int32_t>("entity dimension");
+  if (d < 0 || d > 3) in.fail("entity dimension " + std::to_string(d) + " is not 0..3");
+  return d;
+}
+
+// $MeshFormat: "version file-type data-size", in a binary file followed by the int 1 written in
+// binary, which tells the byte order (manual, MSH 4.1, $MeshFormat).
+void read_mesh_format(MshInput& in) {
+  const std::string version(in.token("version"));
+  const int file_type = in.value<int32_t>("file-type");
+  const int data_size = in.value<int32_t>("data-size");
+  if (version != "4.1")  // 2.x and 4.0 lay the sections out differently
+    in.fail("MSH " + version + (file_type == 1 ? " binary" : " ASCII") +
+            " is not supported, expected MSH 4.1 ASCII or binary (gmsh: -format msh41, or Mesh.MshFileVersion = 4.1)");
+  if (file_type != 0 && file_type != 1) in.fail("file-type " + std::to_string(file_type) + ", expected 0 (ASCII) or 1 (binary)");
+  in.skip_line();
+  if (file_type == 1) {
+    if (data_size != 8) in.fail("data-size " + std::to_string(data_size) + ", expected 8 (double)");
+    in.set_binary(true);
+    const int32_t one = in.value<int32_t>("byte order mark (int 1)");
+    if (one == 0x01000000) in.fail("the file was written in the opposite byte order to this machine's (write it as ASCII)");
+    if (one != 1) in.fail("bad byte order mark " + std::to_string(one) + ", expected the int 1");
+  }
+  in.end_section("$EndMeshFormat");
+}
+
+// $PhysicalNames (ASCII in both encodings): numPhysicalNames, then "dimension tag "name"" lines.
+void read_physical_names(MshInput& in, GmshMeshBuilder& b) {
+  MshInput::AsciiScope ascii(in);
+  const uint64_t n = in.count("numPhysicalNames", Record{.ints = 3});
+  for (uint64_t i = 0; i < n; ++i) {
+    const int dim = in.value<int32_t>("physical dimension");
+    const int tag = in.value<int32_t>("physical tag");
+    b.physical_name(dim, tag, in.quoted("physical name"));
+  }
+  in.end_section("$EndPhysicalNames");
+}
+
+// $Entities: numPoints numCurves numSurfaces numVolumes (size_t), then per entity
+// tag (int), X Y Z for points or a bounding box min/max XYZ (double), numPhysicalTags (size_t),
+// physical tags (int), and for curves/surfaces/volumes numBounding (size_t) and bounding tags (int).
+void read_entities(MshInput& in, GmshMeshBuilder& b) {
+  uint64_t counts[4];
+  for (int d = 0; d < 4; ++d) counts[d] = in.count("number of entities", Record{.ints = 1, .sizes = 1, .doubles = 3});
+  for (int d = 0; d < 4; ++d)
+    for (uint64_t i = 0; i < counts[d]; ++i) {
+      const int tag = in.value<int32_t>("entity tag");
+      in.skip(Record{.doubles = d == 0 ? 3u : 6u}, 1);
+      const uint64_t np = in.count("numPhysicalTags", Record{.ints = 1});
+      for (uint64_t k = 0; k < np; ++k) b.entity_physical(d, tag, in.value<int32_t>("physical tag"));
+      if (d > 0) in.skip(Record{.ints = 1}, in.count("number of bounding entities", Record{.ints = 1}));
+    }
+  in.end_section("$EndEntities");
+}
+
+// One entity block of $Nodes: entityDim entityTag parametric (int) numNodesInBlock (size_t),
+// the node tags (size_t), then per node x y z (double) and, if parametric, u [v [w]] by entityDim.
+void read_node_block(MshInput& in, GmshMeshBuilder& b) {
+  const int dim = entity_dim(in);
+  in.value<int32_t>("entity tag");
+  const int parametric = in.value<int32_t>("parametric");
+  const uint64_t params = parametric ? uint64_t(dim) : 0;
+  const uint64_t n = in.count("numNodesInBlock", Record{.sizes = 1, .doubles = 3 + params});
+  std::vector<uint64_t> tags(n);
+  for (auto& t : tags) t = in.value<uint64_t>("node tag");
+  for (uint64_t t : tags) {
+    Vec3d x;
+    for (int k = 0; k < 3; ++k) x(k) = in.value<double>("node coordinate");
+    if (!x.allFinite()) in.fail("node " + std::to_string(t) + " has a non-finite coordinate");
+    in.skip(Record{.doubles = params}, 1);
+    b.node(t, x);
+  }
+}
+
+// $Nodes: numEntityBlocks numNodes minNodeTag maxNodeTag (size_t), then the entity blocks.
+void read_nodes(MshInput& in, GmshMeshBuilder& b) {
+  const uint64_t blocks = in.count("numEntityBlocks", Record{.ints = 3, .sizes = 1});
+  in.count("numNodes", Record{.sizes = 1, .doubles = 3});
+  in.value<uint64_t>("minNodeTag");
+  in.value<uint64_t>("maxNodeTag");
+  for (uint64_t i = 0; i < blocks; ++i) read_node_block(in, b);
+  in.end_section("$EndNodes");
+}
+
+// One entity block of $Elements: entityDim entityTag elementType (int) numElementsInBlock
+// (size_t), then per element its tag and node tags (size_t).
+void read_element_block(MshInput& in, GmshMeshBuilder& b) {
+  const int dim = entity_dim(in);
+  const int entity = in.value<int32_t>("entity tag");
+  const int type = in.value<int32_t>("element type");
+  const int nn = gmsh_node_count(type);
+  if (nn <= 0) in.fail("element type " + std::to_string(type) + " is unknown (or has a variable node count)");
+  const uint64_t n = in.count("numElementsInBlock", Record{.sizes = 1 + uint64_t(nn)});
+  const auto kind = supported_element(type, dim);
+  for (uint64_t i = 0; i < n; ++i) {
+    const uint64_t tag = in.value<uint64_t>("element tag");
+    if (!kind) {  // e.g. lines, points: not used by the solver
+      in.skip(Record{.sizes = uint64_t(nn)}, 1);
+      continue;
+    }
+    std::array<int, 10> nodes{};
+    for (int a = 0; a < nn; ++a) {
+      const uint64_t t = in.value<uint64_t>("node tag");
+      const auto index = b.node_index(t);
+      if (!index) in.fail("element " + std::to_string(tag) + " has the unknown node tag " + std::to_string(t));
+      nodes[a] = *index;
+    }
+    b.element(*kind, entity, nodes);
+  }
+}
+
+// $Elements: numEntityBlocks numElements minElementTag maxElementTag (size_t), then the blocks.
+void read_elements(MshInput& in, GmshMeshBuilder& b) {
+  const uint64_t blocks = in.count("numEntityBlocks", Record{.ints = 3, .sizes = 1});
+  in.count("numElements", Record{.sizes = 2});
+  in.value<uint64_t>("minElementTag");
+  in.value<uint64_t>("maxElementTag");
+  for (uint64_t i = 0; i < blocks; ++i) read_element_block(in, b);
+  in.end_section("$EndElements");
+}
+}  // namespace
+
+Mesh read_gmsh(const std::string& path, const std::string& part, const std::string& prefix, double scale) {
+  MshInput in(path);
+  GmshMeshBuilder b(part, prefix, scale);
+  std::string sec;
+  if (!in.next_section(sec) || sec != "$MeshFormat")
+    throw std::runtime_error(path + ": not a gmsh mesh file (no $MeshFormat section first)");
+  read_mesh_format(in);
+  while (in.next_section(sec)) {
+    if (sec == "$PhysicalNames")
+      read_physical_names(in, b);
+    else if (sec == "$Entities")
+      read_entities(in, b);
+    else if (sec == "$Nodes")
+      read_nodes(in, b);
+    else if (sec == "$Elements")
+      read_elements(in, b);
+    else if (sec == "$PartitionedEntities")  // elements then sit on partition entities without groups
+      in.fail("partitioned meshes are not supported, save the mesh before partitioning it");
+    else
+      in.skip_section(sec);  // $Periodic, $NodeData, $Parametrizations, ...
+  }
+  return b.finish(path);
 }
 
 }  // namespace angio::solid

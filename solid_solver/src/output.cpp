@@ -1,5 +1,6 @@
 #include "angio/solid/output.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -49,6 +50,41 @@ void write_rows(hid_t file, const std::string& path, hid_t type, long total_rows
   H5Dclose(ds);
 }
 
+// Static per-element vectors written once under /mesh/<type>/ when the mesh has fiber frames
+// (Mesh::frames, one per element): the local material frame (e_c, e_a, e_r) and the directions a0
+// of the element's fiber families resolved from it (materials.hpp, resolve_fibers), so that fiber
+// directions can be checked in ParaView (glyphs).
+std::vector<std::string> cell_vector_names(const SolidModel& model) {
+  const Mesh& mesh = model.mesh();
+  if (mesh.elements.empty() || mesh.frames.size() != mesh.elements.size()) return {};
+  std::vector<std::string> names{"frame_circumferential", "frame_axial", "frame_radial"};
+  size_t families = 0;
+  for (const auto& mat : model.materials()) families = std::max(families, resolve_fibers(mat, Frame{}).size());
+  for (size_t k = 0; k < families; ++k) names.push_back("fiber_" + std::to_string(k + 1));
+  return names;
+}
+
+// The vectors of cell_vector_names() for element e; fiber_k is zero where e has fewer families.
+std::vector<Vec3d> cell_vectors(const SolidModel& model, int e, size_t count) {
+  const Frame& f = model.mesh().frames[e];
+  std::vector<Vec3d> v{f.circumferential, f.axial, f.radial};
+  for (const auto& fiber : resolve_fibers(model.materials()[model.mesh().elements[e].block], f))
+    v.push_back(fiber.a0);
+  v.resize(count, Vec3d::Zero());
+  return v;
+}
+
+// <Attribute> of an XDMF grid: `cols` = 1 (Scalar) or 3 (Vector) values per node or cell
+// (center "Node"/"Cell") from the HDF5 dataset `path` ("solid.h5:/...") of `rows` rows.
+void xdmf_attribute(std::ostream& x, const std::string& name, const char* center, long rows, int cols,
+                    const std::string& path, const char* number = "Float") {
+  const bool real = std::string(number) == "Float";
+  x << "     <Attribute Name=\"" << name << "\" AttributeType=\"" << (cols == 3 ? "Vector" : "Scalar")
+    << "\" Center=\"" << center << "\">\n      <DataItem Dimensions=\"" << rows << (cols == 3 ? " 3" : "")
+    << "\" NumberType=\"" << number << "\"" << (real ? " Precision=\"8\"" : "") << " Format=\"HDF\">" << path
+    << "</DataItem>\n     </Attribute>\n";
+}
+
 const char* xdmf_topology(ElemType t) {
   switch (t) {
     case ElemType::Hex8: return "Hexahedron";
@@ -80,6 +116,7 @@ FieldWriter::FieldWriter(const SolidModel& model, const std::string& dir) : mode
   }
   write_rows(file_, "/mesh/coordinates", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, xyz.data());
   write_rows(file_, "/mesh/original_node_id", H5T_NATIVE_INT, N, 1, n0, n1 - n0, orig.data());
+  cell_vectors_ = cell_vector_names(model);
   // element types present anywhere
   for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
     TypeInfo ti{t, 0, 0, {}};
@@ -108,9 +145,22 @@ FieldWriter::FieldWriter(const SolidModel& model, const std::string& dir) : mode
     write_rows(file_, base + "/connectivity", H5T_NATIVE_INT, ti.total, nn, ti.offset, nloc, conn.data());
     write_rows(file_, base + "/block_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc, block.data());
     write_rows(file_, base + "/original_element_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc, oid.data());
+    write_cell_vectors_(ti, base);
     types_.push_back(std::move(ti));
   }
   H5Fflush(file_, H5F_SCOPE_GLOBAL);
+}
+
+void FieldWriter::write_cell_vectors_(const TypeInfo& ti, const std::string& base) {
+  const long nloc = long(ti.local.size());
+  std::vector<std::vector<double>> data(cell_vectors_.size(), std::vector<double>(3 * nloc));
+  for (long i = 0; i < nloc; ++i) {
+    const auto v = cell_vectors(model_, model_.local_elements()[ti.local[i]], cell_vectors_.size());
+    for (size_t f = 0; f < v.size(); ++f)
+      for (int k = 0; k < 3; ++k) data[f][3 * i + k] = v[f](k);
+  }
+  for (size_t f = 0; f < cell_vectors_.size(); ++f)
+    write_rows(file_, base + "/" + cell_vectors_[f], H5T_NATIVE_DOUBLE, ti.total, 3, ti.offset, nloc, data[f].data());
 }
 
 FieldWriter::~FieldWriter() {
@@ -188,27 +238,15 @@ void FieldWriter::write_xdmf_() {
         << "     </Topology>\n"
         << "     <Geometry GeometryType=\"XYZ\">\n      <DataItem Dimensions=\"" << N
         << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">solid.h5:/mesh/coordinates</DataItem>\n"
-        << "     </Geometry>\n"
-        << "     <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n      <DataItem Dimensions=\""
-        << N << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/displacement</DataItem>\n"
-        << "     </Attribute>\n";
-      for (const auto& field : nodal)
-        x << "     <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"Node\">\n      <DataItem Dimensions=\""
-          << N << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/" << field << "</DataItem>\n"
-          << "     </Attribute>\n";
-      x
-        << "     <Attribute Name=\"block_id\" AttributeType=\"Scalar\" Center=\"Cell\">\n      <DataItem Dimensions=\""
-        << ti.total << "\" NumberType=\"Int\" Format=\"HDF\">solid.h5:/mesh/" << tn << "/block_id</DataItem>\n"
-        << "     </Attribute>\n"
-        << "     <Attribute Name=\"stress_p1\" AttributeType=\"Scalar\" Center=\"Cell\">\n      <DataItem Dimensions=\""
-        << ti.total << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/" << tn
-        << "/stress_p1</DataItem>\n"
-        << "     </Attribute>\n"
-        << "     <Attribute Name=\"stress_p1_dir\" AttributeType=\"Vector\" Center=\"Cell\">\n      <DataItem Dimensions=\""
-        << ti.total << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << g << "/" << tn
-        << "/stress_p1_dir</DataItem>\n"
-        << "     </Attribute>\n"
-        << "    </Grid>\n";
+        << "     </Geometry>\n";
+      xdmf_attribute(x, "displacement", "Node", N, 3, g + "/displacement");
+      for (const auto& field : nodal) xdmf_attribute(x, field, "Node", N, 1, g + "/" + field);
+      const std::string mesh = "solid.h5:/mesh/" + tn + "/";  // static cell data, shared by all steps
+      xdmf_attribute(x, "block_id", "Cell", ti.total, 1, mesh + "block_id", "Int");
+      for (const auto& v : cell_vectors_) xdmf_attribute(x, v, "Cell", ti.total, 3, mesh + v);
+      xdmf_attribute(x, "stress_p1", "Cell", ti.total, 1, g + "/" + tn + "/stress_p1");
+      xdmf_attribute(x, "stress_p1_dir", "Cell", ti.total, 3, g + "/" + tn + "/stress_p1_dir");
+      x << "    </Grid>\n";
     }
     x << "   </Grid>\n";
   }

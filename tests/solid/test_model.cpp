@@ -1,5 +1,6 @@
 // Tests of the distributed solid model (PETSc + MPI). Run under mpirun with 1 or 2 ranks.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <mpi.h>
 #include <petscsys.h>
 
@@ -8,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <numbers>
+#include <type_traits>
 
 #include "angio/scene/node.hpp"
 #include "angio/solid/model.hpp"
@@ -57,6 +59,25 @@ double max_diff(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
   double d = 0.0;
   for (size_t n = 0; n < a.size(); ++n) d = std::max(d, (a[n] - b[n]).norm());
   return d;
+}
+
+// A whole dataset of an HDF5 file (serial read, rank 0), flattened row by row; empty if absent.
+template <class T>
+std::vector<T> read_dataset(const std::string& file, const std::string& path) {
+  std::vector<T> v;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return v;
+  if (H5Lexists(f, path.c_str(), H5P_DEFAULT) > 0) {
+    const hid_t ds = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+    const hid_t space = H5Dget_space(ds);
+    v.resize(size_t(H5Sget_simple_extent_npoints(space)));
+    const hid_t type = std::is_same_v<T, int> ? H5T_NATIVE_INT : H5T_NATIVE_DOUBLE;
+    if (H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) v.clear();
+    H5Sclose(space);
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+  return v;
 }
 
 ModelOptions direct_options() {
@@ -392,6 +413,40 @@ TEST(Model, OneAndTwoRanksGiveSameDisplacements) {
   }
 }
 
+// The fiber frames and fiber directions of the tube's hex8 elements in solid.h5, and as cell
+// attributes of every step in solid.xdmf (small_artery.yaml: media fibers at 0°, adventitia ±40°).
+static void check_fiber_output(const SolidModel& model, const std::string& dir) {
+  const std::string h5 = dir + "/solid.h5";
+  const auto id = read_dataset<int>(h5, "/mesh/hex8/original_element_id");
+  const auto radial = read_dataset<double>(h5, "/mesh/hex8/frame_radial");
+  const auto fiber2 = read_dataset<double>(h5, "/mesh/hex8/fiber_2");
+  const Mesh& mesh = model.mesh();
+  ASSERT_EQ(id.size(), mesh.elements.size());
+  ASSERT_EQ(radial.size(), 3 * id.size());
+  ASSERT_EQ(fiber2.size(), 3 * id.size());
+  EXPECT_TRUE(read_dataset<double>(h5, "/mesh/hex8/fiber_3").empty());  // two families per layer
+  for (size_t i = 0; i < id.size(); ++i) {
+    const Frame& f = mesh.frames.at(id[i]);
+    EXPECT_LT((Vec3d(radial[3 * i], radial[3 * i + 1], radial[3 * i + 2]) - f.radial).norm(), 1e-15);
+    const double deg = mesh.blocks[mesh.elements[id[i]].block].name == "adventitia" ? 40.0 : 0.0;
+    const double phi = deg * std::numbers::pi / 180.0;
+    const Vec3d a0 = std::cos(phi) * f.circumferential - std::sin(phi) * f.axial;  // the mirrored family
+    EXPECT_LT((Vec3d(fiber2[3 * i], fiber2[3 * i + 1], fiber2[3 * i + 2]) - a0).norm(), 1e-14) << "element " << id[i];
+  }
+  std::ifstream x(dir + "/solid.xdmf");
+  const std::string xdmf((std::istreambuf_iterator<char>(x)), {});
+  auto count = [&](const std::string& what) {
+    size_t n = 0;
+    for (size_t at = xdmf.find(what); at != std::string::npos; at = xdmf.find(what, at + 1)) ++n;
+    return n;
+  };
+  const size_t steps = count("<Grid Name=\"step_");
+  EXPECT_GE(steps, 2u);
+  for (const char* name : {"frame_circumferential", "frame_axial", "frame_radial", "fiber_1", "fiber_2"})
+    EXPECT_EQ(count(std::string("Attribute Name=\"") + name + "\" AttributeType=\"Vector\" Center=\"Cell\""), steps) << name;
+  EXPECT_NE(xdmf.find("solid.h5:/mesh/hex8/fiber_2<"), std::string::npos);
+}
+
 // Scene -> runner -> HDF5/XDMF/summary.json on the communicator, two committed steps, one rejected.
 TEST(Runner, WritesOutputAndRollsBack) {
   // per rank count: solid.model.np1 and .np2 run this test concurrently in the same directory
@@ -428,6 +483,7 @@ TEST(Runner, WritesOutputAndRollsBack) {
     std::string s((std::istreambuf_iterator<char>(f)), {});
     EXPECT_NE(s.find("\"media\""), std::string::npos);
     EXPECT_NE(s.find("\"step\": 2"), std::string::npos);
+    check_fiber_output(runner.model(), dir + "/solid");
   }
 }
 

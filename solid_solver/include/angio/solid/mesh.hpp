@@ -1,5 +1,5 @@
 // Solid meshes: element blocks (one material each), surface sets (pressure, springs, contact),
-// node sets; built-in tube generator and gmsh .msh v4 ASCII reader.
+// node sets; built-in tube generator and gmsh .msh 4.1 reader (ASCII and binary).
 #pragma once
 #include <array>
 #include <map>
@@ -86,10 +86,14 @@ struct TubeSpec {
 // Throws std::runtime_error on bad parameters or a tube that does not fit on the centerline.
 Mesh make_tube(const TubeSpec& spec);
 
-// gmsh .msh 4.x ASCII. Volume physical groups become blocks (name = physical name, or
-// "volume_<tag>"), surface physical groups become surface sets. Supported element types:
-// hex8 (5), tet4 (4), tet10 (11), quad4 (3), tri3 (2), tri6 (9); others are ignored.
-// Coordinates are multiplied by `scale`. Throws std::runtime_error("file:line: ...") on bad input.
+// gmsh .msh 4.1, ASCII or binary (data-size 8, this machine's byte order). Volume physical groups become
+// blocks (name = physical name, or "volume_<entity tag>" for a volume without one), surface
+// physical groups become surface sets (<surface_prefix><name>, or "surface_<tag>"). Supported
+// element types: hex8 (5), tet4 (4), tet10 (11), quad4 (3), tri3 (2), tri6 (9); other known gmsh
+// types are skipped. Unknown sections are skipped; MSH 2.x/4.0 and partitioned meshes are refused.
+// Coordinates are multiplied by `scale`. Every count is checked against the bytes left in the file
+// before anything is allocated. Throws std::runtime_error("file:line: ..." for ASCII,
+// "file: ... at byte offset N" for binary files) on bad input.
 Mesh read_gmsh(const std::string& path, const std::string& part, const std::string& surface_prefix,
                double scale = 1.0);
 

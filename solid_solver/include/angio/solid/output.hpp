@@ -6,6 +6,11 @@
 //     /mesh/<type>/connectivity    [E,n]  (tet10 in VTK/XDMF edge order)
 //     /mesh/<type>/block_id        [E]    block (layer) index, see summary.json "blocks"
 //     /mesh/<type>/original_element_id [E]
+//     /mesh/<type>/frame_circumferential, frame_axial, frame_radial [E,3]  if the mesh has fiber
+//                                  frames (Mesh::frames): the element's local material frame
+//     /mesh/<type>/fiber_<k>       [E,3]  with the frames: direction a0 of fiber family k = 1, 2, ...
+//                                         of the element's material (cos φ e_c ± sin φ e_a, zero if
+//                                         the material has fewer families)
 //     /steps/<k>                   attribute "time" (pseudo-time, s)
 //     /steps/<k>/displacement      [N,3]  nodal
 //     /steps/<k>/<type>/stress_p1      [E]   first principal Cauchy stress (MPa), per element:
@@ -13,7 +18,8 @@
 //     /steps/<k>/<type>/stress_p1_dir  [E,3] its unit eigenvector
 //     /steps/<k>/<name>            [N]    extra nodal scalars, e.g. contact_pressure (MPa): |contact
 //                                         force| / lumped nodal area on the endothelium
-//   <dir>/solid.xdmf  (rewritten after every step; open in ParaView with the Xdmf3 reader)
+//   <dir>/solid.xdmf  (rewritten after every step; open in ParaView with the Xdmf3 reader; every
+//                      step's grids carry the static /mesh cell data as attributes too)
 #pragma once
 #include <hdf5.h>
 
@@ -45,6 +51,8 @@ class FieldWriter {
     std::vector<int> local;  // indices into model.local_elements()
   };
   std::vector<TypeInfo> types_;
+  void write_cell_vectors_(const TypeInfo& ti, const std::string& base);  // collective
+  std::vector<std::string> cell_vectors_;  // static per-element vectors under /mesh/<type>/ (frames, fibers)
   struct StepInfo {
     int step;
     double time;
