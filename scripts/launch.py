@@ -5,11 +5,16 @@
   stent only             -> beam_solver alone (beam-only scene)
   balloon/artery only    -> solid_solver alone (mpirun), no coupling iterations
 
+A scene with a `patient:` section (a lumen centerline CSV) is completed first (scripts/patient/:
+stenosis, balloon and stent placement, three-layer tet10 artery mesh); the solvers then read the
+completed scene <run_dir>/scene.yaml and the user's scene is kept as <run_dir>/scene.input.yaml.
+
 A unique endpoint per run (a unix socket in the run directory, or a free loopback TCP port) keeps
 parallel runs apart. Ctrl-C is forwarded to every process; if one process fails, the others are
 stopped and the exit code names the failing process. Units in scenes: mm, N, MPa, s.
 """
 import argparse
+import atexit
 import ctypes
 import difflib
 import fcntl
@@ -17,11 +22,13 @@ import math
 import os
 import re
 import shlex
+import shutil
 import signal
 import socket
 import stat
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import uuid
@@ -34,7 +41,7 @@ UNIX_PATH_MAX = 107
 # The top-level sections some executable reads (README "Scenes"). The launcher picks the processes
 # from these keys, so a misspelt one must stop the launch instead of silently running another
 # simulation (a scene without its `stent` runs the balloon alone).
-SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling")
+SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling", "patient")
 # Catches typos (-n 2000 oversubscribes the machine into the ground) without limiting real runs.
 MAX_RANKS = 256
 # The run id is a chunk of the zenoh key expressions angio/<run_id>/...: '/' would shift the chunks
@@ -133,6 +140,53 @@ def load_scene(path):
             hint = f"; did you mean `{near[0]}`?" if near else ""
             die(f"{path}: {key}: expected a top-level section ({', '.join(SECTIONS)}), got an unknown key{hint}")
     return scene, data
+
+
+def prepare_patient(scene, scene_path):
+    """Runs the patient pipeline into a scratch directory: (scratch dir, completed scene). Bad input
+    (the centerline, the patient keys, devices that do not fit) exits 2 naming the file and key."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        from patient.errors import PatientInputError
+        from patient.prepare import prepare_scene
+    except ImportError as e:  # numpy/scipy/gmsh missing: a setup problem, not a bad scene
+        die(f"{scene_path}: patient: the pipeline needs numpy, scipy and gmsh (scripts/setup.sh): {e}", code=1)
+    scratch = Path(tempfile.mkdtemp(prefix="angio-patient-"))
+    atexit.register(shutil.rmtree, scratch, True)  # left over only if the launch stops before the move
+    try:
+        done, _ = prepare_scene(scene, scene_path, scratch, log=lambda m: print(f"launch: {m}", flush=True))
+    except PatientInputError as e:
+        shutil.rmtree(scratch, ignore_errors=True)
+        die(str(e))
+    except Exception as e:  # gmsh (a bare Exception) or the layer split: a geometry it cannot mesh
+        shutil.rmtree(scratch, ignore_errors=True)
+        die(f"{scene_path}: patient: cannot mesh the artery from this centerline: {' '.join(str(e).split())}")
+    return scratch, done
+
+
+def install_prepared(prepared, run_dir):
+    """Moves the generated geometry to <run_dir>/geometry and writes the completed scene with its
+    paths there; returns the completed scene's path."""
+    scratch, done = prepared
+    dest = run_dir / "geometry"
+    if dest.exists():  # a reused --run-dir: the geometry of this launch replaces the last one's
+        shutil.rmtree(dest)
+    shutil.move(str(scratch), str(dest))
+
+    def relocate(node):
+        if isinstance(node, dict):
+            return {k: relocate(v) for k, v in node.items()}
+        if isinstance(node, list):
+            return [relocate(v) for v in node]
+        if isinstance(node, str) and node.startswith(str(scratch)):
+            return str(dest) + node[len(str(scratch)):]
+        return node
+
+    path = run_dir / "scene.yaml"
+    with open(path, "w") as f:
+        f.write("# Completed by the launcher from scene.input.yaml (patient pipeline, geometry/placement.json)\n")
+        yaml.safe_dump(relocate(done), f, sort_keys=False)
+    return path
 
 
 def free_tcp_port():
@@ -356,6 +410,10 @@ def main():
     if args.ranks is not None:
         ranks = args.ranks
 
+    # A patient scene: geometry and mesh are generated before the run directory exists (bad input
+    # leaves nothing behind), into a scratch directory moved into the run directory below.
+    prepared = prepare_patient(scene, scene_path) if "patient" in scene else None
+
     build = Path(args.build_dir).resolve()
     mpirun = ["mpirun", "-n", str(ranks), "--oversubscribe", "--bind-to", "none"]
     if os.geteuid() == 0:
@@ -376,11 +434,16 @@ def main():
     run_dir = Path(args.run_dir or ROOT / "runs" / f"{scene_path.stem}-{stamp}-{token}").resolve()
     make_run_dir(run_dir, explicit=args.run_dir is not None)
     lock = lock_run_dir(run_dir)  # the flock lasts as long as this open file, i.e. until main returns
+    solver_scene = scene_path
     try:
-        (run_dir / "scene.yaml").write_bytes(scene_text)  # the text that was checked
+        if prepared is None:
+            (run_dir / "scene.yaml").write_bytes(scene_text)  # the text that was checked
+        else:
+            (run_dir / "scene.input.yaml").write_bytes(scene_text)
+            solver_scene = install_prepared(prepared, run_dir)
     except OSError as e:
-        die(f"{run_dir / 'scene.yaml'}: cannot write: {e.strerror}")
-    common = ["--scene", str(scene_path), "--run-dir", str(run_dir), "--log-level", args.log_level,
+        die(f"{run_dir}: cannot write the scene: {e.strerror}")
+    common = ["--scene", str(solver_scene), "--run-dir", str(run_dir), "--log-level", args.log_level,
               "--timeout", str(args.timeout)]
 
     plan = []

@@ -51,6 +51,13 @@ PAPER_ARTERY = {"diameter_initial": 1.15, "diameter_peak": 2.12, "diameter_final
                 "stress": {"prestressed": {"media": 0.0023, "adventitia": 0.00017},
                            "peak": {"innermost": 7.99, "adventitia": 0.0495},
                            "after": {"media": 0.1875, "adventitia": 0.0137}}}
+# Paper §4.2.3 (its patient's right coronary artery, Fig. 12), for patient scenes (a run directory
+# with geometry/placement.json): max first principal Cauchy stress per layer, the intima being the
+# innermost layer (endothelium); the prestressed media/adventitia values are not stated. A patient
+# of our own (configs/patient_like.yaml) is a different artery: the column gives the magnitudes.
+PAPER_PATIENT = {"stress": {"prestressed": {"innermost": 0.0481},
+                            "peak": {"innermost": 0.757, "media": 0.0783, "adventitia": 0.1359},
+                            "after": {"innermost": 0.1914, "media": 0.0489, "adventitia": 0.0495}}}
 ATM = 0.101325  # MPa
 KPA = 1000.0    # kPa per MPa
 PHASES = ("prestressed", "peak", "after")
@@ -214,7 +221,8 @@ def artery_report(run, scene, solid, beam, with_paper):
     """Table rows (stent rows, artery rows), the results.json "artery" section and the plot data of an
     artery scene."""
     rows, stent_rows = [], []
-    P = PAPER_ARTERY if with_paper else {}
+    P = ((PAPER_PATIENT if (run / "geometry" / "placement.json").is_file() else PAPER_ARTERY)
+         if with_paper else {})
     pstress = P.get("stress", {})
     steps = [s for s in (get(solid, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
     beam_steps = [s for s in (get(beam, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
@@ -425,7 +433,27 @@ def artery_report(run, scene, solid, beam, with_paper):
     x_is_station = n_st > 0 and all(v is not None for v in stations)
     plots = {"stress": stress_series, "lumen": lumen_series, "force": force_series,
              "span": ext if (ext and x_is_station) else None, "lumen_x": "station" if x_is_station else "index"}
+    straight = artery_straightening(run, times)
+    if straight:
+        section["straightening"] = straight
+        labels = ["reference"] + [k for k in PHASES if k in straight]
+        rows += [(f"artery axis sagitta {' / '.join(labels)} (mm)",
+                  " / ".join(f"{straight[k]['sagitta']:.3f}" for k in labels), None),
+                 (f"artery axis radius {' / '.join(labels)} (mm)",
+                  " / ".join(f"{straight[k]['radius']:.1f}" for k in labels), None)]
     return (stent_rows, rows), section, plots
+
+
+def artery_straightening(run, times):
+    """Bow of a patient artery's lumen axis over the stented section (scripts/patient/straightening.py)."""
+    if not (run / "geometry" / "placement.json").is_file():
+        return None
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    try:
+        from patient.straightening import artery_axis_bow
+        return artery_axis_bow(run, times)
+    except ImportError:  # h5py or numpy missing: the table goes without it
+        return None
 
 
 # ------------------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ PACKAGES=(
   petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev libhdf5-dev
   flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev nlohmann-json3-dev
   libgtest-dev googletest
-  python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml
+  python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml python3-gmsh
 )
 
 missing=()

@@ -31,7 +31,12 @@ LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<doub
   distinct.erase(std::unique(distinct.begin(), distinct.end(), [&](double a, double b) { return b - a <= tol; }),
                  distinct.end());
   const bool rings = int(distinct.size()) <= max_stations;
-  const int n = rings ? int(distinct.size()) : max_stations;
+  // Unstructured mesh (e.g. a tet10 patient artery): a station's diameter is 2 × the mean distance
+  // of its nodes from their centroid, which is biased low when a few nodes cover only part of the
+  // circumference. Bins hold kMinNodes nodes on average, and sparse ones are dropped below.
+  constexpr int kMinNodes = 24;
+  const int n = rings ? int(distinct.size())
+                      : std::max(1, std::min(max_stations, int(nodes.size()) / kMinNodes));
   groups_.assign(n, {});
   std::vector<double> sum(n, 0.0);
   for (size_t i = 0; i < nodes.size(); ++i) {
@@ -44,22 +49,34 @@ LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<doub
     groups_[k].push_back(nodes[i]);
     sum[k] += station[i];
   }
+  // an empty bin, or (unstructured) one with too few nodes to go around the lumen, is no station
+  const size_t min_nodes = rings ? 1 : kMinNodes / 3;
   for (int k = 0; k < n; ++k)
-    if (!groups_[k].empty()) {
-      s_.push_back(sum[k] / double(groups_[k].size()));
-    }
-  groups_.erase(std::remove_if(groups_.begin(), groups_.end(), [](const auto& g) { return g.empty(); }),
+    if (groups_[k].size() >= min_nodes) s_.push_back(sum[k] / double(groups_[k].size()));
+  groups_.erase(std::remove_if(groups_.begin(), groups_.end(), [&](const auto& g) { return g.size() < min_nodes; }),
                 groups_.end());
 }
 
 std::vector<double> LumenProfile::diameters(const std::vector<Vec3d>& x) const {
-  std::vector<double> d(groups_.size(), 0.0);
-  for (size_t k = 0; k < groups_.size(); ++k) {
-    Vec3d c = Vec3d::Zero();
-    for (int n : groups_[k]) c += x[n];
-    c /= double(groups_[k].size());
+  const size_t m = groups_.size();
+  std::vector<Vec3d> c(m, Vec3d::Zero());
+  for (size_t k = 0; k < m; ++k) {
+    for (int n : groups_[k]) c[k] += x[n];
+    c[k] /= double(groups_[k].size());
+  }
+  // Distances are taken in the station's cross-section: normal to the local lumen axis through the
+  // neighbouring centroids (current configuration, so a bending vessel is followed). The nodes of
+  // an unstructured station spread along the axis and would otherwise count that spread as radius.
+  std::vector<double> d(m, 0.0);
+  for (size_t k = 0; k < m; ++k) {
+    Vec3d t = m > 1 ? Vec3d(c[std::min(k + 1, m - 1)] - c[k > 0 ? k - 1 : 0]) : Vec3d::Zero();
+    const double tn = t.norm();
+    t = tn > 0 ? Vec3d(t / tn) : Vec3d::Zero();
     double r = 0.0;
-    for (int n : groups_[k]) r += (x[n] - c).norm();
+    for (int n : groups_[k]) {
+      const Vec3d v = x[n] - c[k];
+      r += (v - v.dot(t) * t).norm();
+    }
     d[k] = 2.0 * r / double(groups_[k].size());
   }
   return d;

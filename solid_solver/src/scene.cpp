@@ -71,13 +71,16 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     try {
       m = read_gmsh(path, part, prefix, mesh.positive_or("scale", 1.0));
     } catch (const std::exception& e) {
-      mesh.child("file").fail(std::string("a readable gmsh 4.x ASCII mesh (") + e.what() + ")");
+      mesh.child("file").fail(std::string("a readable gmsh 4.1 mesh, ASCII or binary (") + e.what() + ")");
     }
     axis = read_axis(mesh, Vec3d::Zero());
     if (auto cl = mesh.optional("centerline")) {
-      // fiber frames from a lumen centerline (patient-specific arteries): [[x, y, z], ...],
-      // {points: [...]} or {file: ...} (the key shape of the tube generator and the stent)
-      set_frames_from_centerline(m, geometry::centerline_from_scene(*cl).points());
+      // fiber frames from a lumen centerline (patient-specific arteries, paper §4.2.1): [[x, y, z], ...],
+      // {points: [...]} or {file: ...} (the key shape of the tube generator and the stent); the
+      // summary's lumen stations are then arc lengths along it
+      geometry::Centerline c = geometry::centerline_from_scene(*cl);
+      set_frames_from_centerline(m, c.points());
+      curved = std::move(c);
     } else {
       set_frames_from_axis(m, axis);
     }

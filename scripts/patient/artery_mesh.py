@@ -1,0 +1,241 @@
+"""Three-layer tet10 artery around a lumen centerline, meshed with gmsh (paper §4.2.1).
+
+Wall: the lumen radius r and the total wall thickness per station (the centerline CSV's `wall`
+column or one number). Media and adventitia have thicknesses proportional to the outer diameter
+D = 2 (r + wall) (paper §4.2.1, after Holzapfel et al. 2005, Am J Physiol Heart 289:H2048); the
+rest of the wall is intima. Each interface is a loft (OpenCASCADE ThruSections) through circles in
+the normal planes of the centerline stations; the four nested solids are fragmented into conforming
+layers and the lumen core removed.
+
+Physical groups (the names the solid solver and the scene use): volumes `intima`, `media`,
+`adventitia`; surfaces `endothelium` (lumen wall), `outer`, `end0` (first station), `end1`.
+"""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import PatientInputError
+
+LAYERS = ("intima", "media", "adventitia")
+
+
+@dataclass
+class WallSpec:
+    media_ratio: float        # media thickness / outer diameter
+    adventitia_ratio: float   # adventitia thickness / outer diameter
+    min_intima: float         # mm: thinner intima is refused (no elements fit in it)
+
+
+def rotation_minimizing_normals(pts):
+    """Tangents and first normals along a polyline by the double reflection method (Wang, Jüttler,
+    Zheng, Liu 2008, ACM TOG 27(1) 2): circles of successive stations start at corresponding
+    points, so the lofted surfaces do not twist."""
+    t = np.gradient(pts, axis=0)
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    ref = np.array([1.0, 0.0, 0.0]) if abs(t[0, 0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    n = np.empty_like(pts)
+    n[0] = ref - ref.dot(t[0]) * t[0]
+    n[0] /= np.linalg.norm(n[0])
+    for i in range(len(pts) - 1):
+        v1 = pts[i + 1] - pts[i]
+        c1 = v1.dot(v1)
+        rL = n[i] - 2.0 / c1 * v1.dot(n[i]) * v1
+        tL = t[i] - 2.0 / c1 * v1.dot(t[i]) * v1
+        v2 = t[i + 1] - tL
+        c2 = v2.dot(v2)
+        n[i + 1] = rL - (2.0 / c2 * v2.dot(rL) * v2 if c2 > 1e-300 else 0.0)
+        n[i + 1] -= n[i + 1].dot(t[i + 1]) * t[i + 1]
+        n[i + 1] /= np.linalg.norm(n[i + 1])
+    return t, n
+
+
+def resample(points, values, spacing):
+    """Stations at (about) equal arc-length spacing, values interpolated linearly."""
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    n = max(int(math.ceil(s[-1] / spacing)), 3) + 1
+    si = np.linspace(0.0, s[-1], n)
+    P = np.column_stack([np.interp(si, s, points[:, c]) for c in range(3)])
+    return si, P, [np.interp(si, s, v) for v in values]
+
+
+def layer_radii(r, wall, spec, where):
+    """Radii of the lumen, intima/media, media/adventitia and outer surfaces per station."""
+    D = 2.0 * (r + wall)
+    tm = spec.media_ratio * D
+    ta = spec.adventitia_ratio * D
+    ti = wall - tm - ta
+    k = int(np.argmin(ti))
+    if ti[k] < spec.min_intima:
+        raise PatientInputError(
+            f"{where}: the wall ({wall[k]:.3f} mm at station {k}) is too thin for media ({tm[k]:.3f} mm) and "
+            f"adventitia ({ta[k]:.3f} mm) with an intima of at least {spec.min_intima:g} mm: expected a thicker wall "
+            f"or smaller media_ratio/adventitia_ratio")
+    return np.column_stack([r, r + ti, r + ti + tm, r + wall]), ti, tm, ta
+
+
+def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, loft_spacing=0.5,
+                 lumen_size=None, where="patient", log=print):
+    """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts."""
+    import gmsh
+
+    s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
+    radii, ti, tm, ta = layer_radii(r, w, spec, where)
+    t, n1 = rotation_minimizing_normals(P)
+    n2 = np.cross(t, n1)
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("artery")
+        occ = gmsh.model.occ
+        solids = []
+        for layer in range(4):
+            wires = []
+            for i in range(len(P)):
+                c = occ.addPoint(*P[i])
+                R = radii[i, layer]
+                q = [occ.addPoint(*(P[i] + R * (math.cos(a) * n1[i] + math.sin(a) * n2[i])))
+                     for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
+                arcs = [occ.addCircleArc(q[k], c, q[(k + 1) % 4]) for k in range(4)]
+                wires.append(occ.addWire(arcs))
+            vol = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
+            solids.append([dt for dt in vol if dt[0] == 3])
+        all_in = [dt for sl in solids for dt in sl]
+        _, pieces_of = occ.fragment(all_in, [])
+        occ.synchronize()
+        # a piece inside k of the four nested solids: 4 = lumen core, 3 intima, 2 media, 1 adventitia
+        count = {}
+        for inp in pieces_of:
+            for dt in inp:
+                count[dt] = count.get(dt, 0) + 1
+        by_layer = {name: [] for name in LAYERS}
+        core = []
+        for dt, k in count.items():
+            if k == 4:
+                core.append(dt)
+            else:
+                by_layer[LAYERS[3 - k]].append(dt[1])
+        if any(not v for v in by_layer.values()) or not core:
+            raise RuntimeError("gmsh fragment did not give three nested layers")
+
+        def faces(vols):
+            out = set()
+            for v in vols:
+                out.update(tag for d, tag in gmsh.model.getBoundary([(3, v)], oriented=False, combined=False) if d == 2)
+            return out
+
+        core_faces = faces([c[1] for c in core])
+        f_int, f_med, f_adv = (faces(by_layer[n]) for n in LAYERS)
+
+        def on_plane(tag, p, normal):
+            c = np.array(occ.getCenterOfMass(2, tag))
+            return abs((c - p).dot(normal)) < 1e-3 * (1.0 + loft_spacing)
+
+        walls = f_int | f_med | f_adv
+        end0 = sorted(f for f in walls if on_plane(f, P[0], t[0]))
+        end1 = sorted(f for f in walls if on_plane(f, P[-1], t[-1]))
+        endo = sorted((core_faces & f_int) - set(end0) - set(end1))
+        outer = sorted(f_adv - f_med - set(end0) - set(end1))
+        occ.remove(core, recursive=True)
+        occ.synchronize()
+        for name in LAYERS:
+            gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, by_layer[name]), name)
+        for name, tags in (("endothelium", endo), ("outer", outer), ("end0", end0), ("end1", end1)):
+            if not tags:
+                raise RuntimeError(f"no faces found for the surface '{name}'")
+            gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
+        # the lumen is what the stent and balloon touch: optionally finer there (lumen_size), growing
+        # to mesh_size through the wall. Curved tet10 faces follow the circular lumen to O(h^3), so
+        # the default is one size.
+        h_lumen = min(mesh_size, lumen_size) if lumen_size else mesh_size
+        if h_lumen < mesh_size:
+            f_dist = gmsh.model.mesh.field.add("Distance")
+            gmsh.model.mesh.field.setNumbers(f_dist, "FacesList", endo)
+            f_thr = gmsh.model.mesh.field.add("Threshold")
+            gmsh.model.mesh.field.setNumber(f_thr, "InField", f_dist)
+            gmsh.model.mesh.field.setNumber(f_thr, "SizeMin", h_lumen)
+            gmsh.model.mesh.field.setNumber(f_thr, "SizeMax", mesh_size)
+            gmsh.model.mesh.field.setNumber(f_thr, "DistMin", 0.0)
+            gmsh.model.mesh.field.setNumber(f_thr, "DistMax", float(w.max()))
+            gmsh.model.mesh.field.setAsBackgroundMesh(f_thr)
+            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * mesh_size)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)       # Delaunay
+        gmsh.option.setNumber("Mesh.Optimize", 1)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.model.mesh.generate(3)
+        gmsh.model.mesh.setOrder(2)                         # tet10 / tri6 on the curved geometry
+        if _min_quadratic_jacobian() <= 0.0:
+            # a mid-edge node pulled onto the curved boundary can invert a thin element: untangle
+            # with gmsh's optimizer, and straighten what it leaves inverted
+            gmsh.option.setNumber("Mesh.HighOrderOptimize", 2)
+            try:
+                gmsh.model.mesh.optimize("HighOrder")
+            except Exception as e:  # gmsh raises a bare Exception when it cannot reach its target
+                log(f"patient: gmsh's high-order optimization stopped ({' '.join(str(e).split())})")
+        straightened = _straighten_inverted()
+        if straightened:
+            log(f"patient: {straightened} tet10 straightened (mid-edge nodes at the edge midpoints) to keep "
+                f"every Jacobian positive")
+        if not _min_quadratic_jacobian() > 0.0:
+            raise RuntimeError("gmsh produced an inverted tetrahedron")
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
+        gmsh.option.setNumber("Mesh.SaveAll", 0)
+        gmsh.write(str(out_path))
+        types, tags, _ = gmsh.model.mesh.getElements(3)
+        n_tets = sum(len(tg) for tg in tags)
+        node_tags, _, _ = gmsh.model.mesh.getNodes()
+        per_layer = {name: sum(len(tg) for v in by_layer[name] for tg in gmsh.model.mesh.getElements(3, v)[1])
+                     for name in LAYERS}
+        return {"file": str(out_path), "elements": int(n_tets), "nodes": int(len(node_tags)),
+                "dofs": 3 * int(len(node_tags)), "per_layer": per_layer, "mesh_size": mesh_size,
+                "lumen_size": h_lumen, "straightened_tet10": int(straightened), "stations": int(len(P)),
+                "thickness_range": {"intima": [float(ti.min()), float(ti.max())],
+                                    "media": [float(tm.min()), float(tm.max())],
+                                    "adventitia": [float(ta.min()), float(ta.max())],
+                                    "wall": [float(w.min()), float(w.max())]}}
+    finally:
+        gmsh.finalize()
+
+
+def _min_quadratic_jacobian():
+    """Smallest Jacobian determinant of the tet10 elements at their Gauss points (gmsh's own)."""
+    import gmsh
+    lo = math.inf
+    types, _, _ = gmsh.model.mesh.getElements(3)
+    for et in types:
+        pts, _ = gmsh.model.mesh.getIntegrationPoints(et, "Gauss4")
+        _, dets, _ = gmsh.model.mesh.getJacobians(et, pts)
+        if len(dets):
+            lo = min(lo, float(np.min(dets)))
+    return lo
+
+
+# gmsh tet10 mid-edge nodes 4..9 on the edges 01 12 20 30 32 31 (gmsh manual, "Node ordering")
+TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
+
+
+def _straighten_inverted(max_rounds=5):
+    """Moves the mid-edge nodes of tet10 with a non-positive Jacobian to their edge midpoints (a
+    straight-sided tet10 is valid whenever its tet4 is); returns how many elements were changed."""
+    import gmsh
+    changed = set()
+    for _ in range(max_rounds):
+        pts, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
+        tags, nodes = gmsh.model.mesh.getElementsByType(11)
+        _, dets, _ = gmsh.model.mesh.getJacobians(11, pts)
+        ng = len(pts) // 3
+        bad = np.nonzero(dets.reshape(len(tags), ng).min(axis=1) <= 0.0)[0]
+        if not len(bad):
+            break
+        nodes = nodes.reshape(-1, 10)
+        for e in bad:
+            changed.add(int(tags[e]))
+            corner = [np.array(gmsh.model.mesh.getNode(int(nodes[e, a]))[0]) for a in range(4)]
+            for k, (a, b) in enumerate(TET10_EDGES):
+                gmsh.model.mesh.setNode(int(nodes[e, 4 + k]), list(0.5 * (corner[a] + corner[b])), [])
+    return len(changed)

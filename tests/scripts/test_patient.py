@@ -1,0 +1,210 @@
+#!/usr/bin/python3
+"""Patient pipeline (scripts/patient/): centerline CSV checks, device placement (paper §2.4, eq. 3)
+and the three-layer tet10 artery mesh (paper §4.2.1). Consistency checks against the definitions:
+eq. (3) evaluated on the fitted spline, clearances recomputed from the geometry, mesh groups and
+Jacobians read back through gmsh."""
+import math
+import os
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+from patient.artery_mesh import TET10_EDGES, WallSpec, build_artery, layer_radii  # noqa: E402
+from patient.centerline_csv import read_centerline_csv, write_centerline_csv  # noqa: E402
+from patient.errors import PatientInputError  # noqa: E402
+from patient.placement import Device, nearest_on_polyline, place_device, stenosis_site  # noqa: E402
+
+
+def arc(n=60, length=12.0, bend=20.0, r0=0.9, stenosis=0.25, noise=0.0, seed=1, wiggle=0.0):
+    s = np.linspace(0.0, length, n)
+    pts = np.column_stack([bend * np.sin(s / bend), bend * (1 - np.cos(s / bend)),
+                           0.2 * np.sin(s) + wiggle * np.sin(2 * np.pi * s / 2.5)])
+    if noise:
+        pts = pts + noise * np.random.default_rng(seed).standard_normal(pts.shape)
+    r = r0 * (1 - stenosis * np.exp(-((s - 0.5 * length) / 1.5) ** 2))
+    wall = 0.7 + 0.3 * np.exp(-((s - 0.5 * length) / 1.5) ** 2)
+    return pts, r, wall
+
+
+class Csv(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory(prefix=f"patient-csv-{os.getpid()}-")
+        self.path = Path(self.dir.name) / "c.csv"
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def write(self, text):
+        self.path.write_text(text)
+        return str(self.path)
+
+    def refused(self, text, *parts):
+        with self.assertRaises(PatientInputError) as cm:
+            read_centerline_csv(self.write(text))
+        msg = str(cm.exception)
+        self.assertIn(str(self.path), msg)
+        for p in parts:
+            self.assertIn(p, msg)
+        return msg
+
+    def test_round_trip(self):
+        pts, r, wall = arc()
+        write_centerline_csv(self.path, pts, r, wall, comment="test")
+        cl = read_centerline_csv(str(self.path))
+        np.testing.assert_allclose(cl.points, pts, atol=1e-6)
+        np.testing.assert_allclose(cl.radius, r, atol=1e-6)
+        np.testing.assert_allclose(cl.wall, wall, atol=1e-6)
+
+    def test_bad_files(self):
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1,1\n0,0,2,1\n", "at least 4")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1,1\n0,0,1,1\n0,0,2,1\n", "repeated", ":4")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1,0\n0,0,2,1\n0,0,3,1\n", "positive lumen radius", ":3")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1,-1\n0,0,2,1\n0,0,3,1\n", "positive lumen radius")
+        self.refused("x,y,z\n0,0,0\n", "no column 'r'")
+        self.refused("x,y,z,r,radius\n", "unknown column 'radius'")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1,nan\n0,0,2,1\n0,0,3,1\n", "finite")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1,abc\n0,0,2,1\n0,0,3,1\n", "expected a number")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,1\n", "expected 4 values")
+        self.refused("x,y,z,r\n0,0,0,1\n0,0,2,1\n0,0,1,1\n0,0,3,1\n", "reversals")
+        self.refused("x,y,z,r,wall\n0,0,0,1,0.5\n0,0,1,1,0\n0,0,2,1,1\n0,0,3,1,1\n", "positive wall")
+        self.refused("", "no data")
+        self.path.write_bytes(b"\xff\xfe\x00binary")
+        with self.assertRaises(PatientInputError):
+            read_centerline_csv(str(self.path))
+
+
+class Placement(unittest.TestCase):
+    DEV = Device(balloon_length=8.0, balloon_radius=0.3, stent_length=6.0, stent_radius=0.4)
+
+    def centerline(self, **kw):
+        d = tempfile.mkdtemp(prefix=f"patient-pl-{os.getpid()}-")
+        pts, r, wall = arc(**kw)
+        p = Path(d) / "c.csv"
+        write_centerline_csv(p, pts, r, wall)
+        return read_centerline_csv(str(p))
+
+    def test_eq3_holds_on_a_rough_centerline(self):
+        # a 0.5 mm wiggle of 2.5 mm wavelength: the least-squares cubic leaves more than zeta, so
+        # FITPACK adds knots until eq. (3) holds as an equality within eps_zeta = 1e-3
+        cl = self.centerline(n=100, wiggle=0.5, stenosis=0.0, r0=1.6)
+        s_site = stenosis_site(cl, 6.0)
+        plc = place_device(cl, self.DEV, s_site, zeta=4.0)
+        z = plc.spline[2]  # the wiggle is in z; x and y are fitted by the cubic
+        self.assertTrue(z["eq3_equality"], z)
+        self.assertLess(abs(z["residual"] - 4.0), 1e-3 * 4.0)
+        self.assertGreater(z["interior_knots"], 0)
+
+    def test_smooth_centerline_gives_the_least_squares_cubic(self):
+        cl = self.centerline(noise=0.0)
+        plc = place_device(cl, self.DEV, stenosis_site(cl))
+        for sp in plc.spline:
+            self.assertEqual(sp["interior_knots"], 0)
+            self.assertLess(sp["residual"], 4.0)
+
+    def test_site_and_clearance(self):
+        cl = self.centerline(noise=0.01, seed=3)
+        s_site = stenosis_site(cl)
+        self.assertAlmostEqual(s_site, cl.arc_length[np.argmin(cl.radius)])
+        plc = place_device(cl, self.DEV, s_site, margin=0.02)
+        # recompute the clearance of the written device centerline against the lumen tube
+        sig = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(plc.points, axis=0), axis=1))])
+        inside = (sig >= plc.balloon_start) & (sig <= plc.balloon_start + self.DEV.balloon_length)
+        d, r = nearest_on_polyline(cl.points, cl.radius, plc.points[inside])
+        self.assertGreaterEqual((r - d - self.DEV.balloon_radius).min(), 0.02 - 1e-3)
+        self.assertGreaterEqual(plc.clearance_stent, 0.02 - 1e-9)
+        # devices centred on the site: the device centerline passes the site's normal plane at sigma_site
+        self.assertAlmostEqual(plc.stent_start + 0.5 * self.DEV.stent_length, plc.sigma_site)
+        self.assertAlmostEqual(plc.balloon_start + 0.5 * self.DEV.balloon_length, plc.sigma_site)
+        q = np.array([np.interp(plc.sigma_site, sig, plc.points[:, c]) for c in range(3)])
+        self.assertLess(np.linalg.norm(q - plc.site_point), plc.site_radius)
+
+    def test_weights_pull_the_spline_into_a_tight_lumen(self):
+        # a tight stenosis in a bend: uniform weights put the stent into the wall, adapted ones do not
+        cl = self.centerline(n=80, length=12.0, bend=6.0, r0=0.75, stenosis=0.35, noise=0.005)
+        dev = Device(balloon_length=8.0, balloon_radius=0.3, stent_length=6.0, stent_radius=0.45)
+        plc = place_device(cl, dev, stenosis_site(cl), zeta=4.0)
+        self.assertGreater(plc.weight_rounds, 0)
+        self.assertGreaterEqual(plc.clearance_stent, 0.0)
+
+    def test_refusals(self):
+        cl = self.centerline()
+        with self.assertRaisesRegex(PatientInputError, "reaches beyond the centerline"):
+            place_device(cl, Device(20.0, 0.3, 6.0, 0.4), stenosis_site(cl))
+        with self.assertRaisesRegex(PatientInputError, "does not fit in the lumen"):
+            place_device(cl, Device(8.0, 0.3, 6.0, 0.8), stenosis_site(cl))
+        with self.assertRaisesRegex(PatientInputError, "longer than the balloon"):
+            place_device(cl, Device(8.0, 0.3, 9.0, 0.4), stenosis_site(cl))
+        with self.assertRaisesRegex(PatientInputError, "within the centerline"):
+            stenosis_site(cl, 100.0)
+
+
+class ArteryMesh(unittest.TestCase):
+    def test_three_layers_tet10(self):
+        import gmsh
+        pts, r, wall = arc(n=30, length=6.0, r0=0.8, stenosis=0.2)
+        spec = WallSpec(media_ratio=0.06, adventitia_ratio=0.065, min_intima=0.05)
+        with tempfile.TemporaryDirectory(prefix=f"patient-mesh-{os.getpid()}-") as d:
+            for binary in (False, True):
+                out = Path(d) / f"a{int(binary)}.msh"
+                info = build_artery(pts, r, wall, spec, 0.9, out, binary=binary, log=lambda m: None)
+                self.assertGreater(info["elements"], 50)
+                gmsh.initialize()
+                try:
+                    gmsh.option.setNumber("General.Terminal", 0)
+                    gmsh.open(str(out))
+                    names = {(dim, gmsh.model.getPhysicalName(dim, tag)) for dim, tag in gmsh.model.getPhysicalGroups()}
+                    self.assertEqual(names, {(3, "intima"), (3, "media"), (3, "adventitia"), (2, "endothelium"),
+                                             (2, "outer"), (2, "end0"), (2, "end1")})
+                    types = gmsh.model.mesh.getElementTypes(3)
+                    self.assertEqual(list(types), [11])  # tet10 only
+                    self.assertEqual(list(gmsh.model.mesh.getElementTypes(2)), [9])  # tri6 faces
+                    pts_q, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
+                    _, det, _ = gmsh.model.mesh.getJacobians(11, pts_q)
+                    self.assertGreater(det.min(), 0.0)
+                    # the endothelium lies on the lumen tube, the outer surface at r + wall
+                    for name, target in (("endothelium", 0), ("outer", 3)):
+                        tag = [t for dim, t in gmsh.model.getPhysicalGroups(2) if gmsh.model.getPhysicalName(2, t) == name][0]
+                        _, xyz = gmsh.model.mesh.getNodesForPhysicalGroup(2, tag)
+                        radii, *_ = layer_radii(r, wall, spec, "test")
+                        dist, rr = nearest_on_polyline(pts, radii[:, target], xyz.reshape(-1, 3))
+                        self.assertLess(np.abs(dist - rr).max(), 0.05 * rr.max(), name)
+                finally:
+                    gmsh.finalize()
+
+    def test_thin_wall_refused(self):
+        pts, r, wall = arc(n=30, length=6.0)
+        with self.assertRaisesRegex(PatientInputError, "too thin"):
+            layer_radii(r, 0.2 * wall, WallSpec(0.06, 0.065, 0.05), "c.csv")
+
+    def test_edge_table_is_gmsh_order(self):
+        import gmsh
+        gmsh.initialize()
+        try:
+            props = gmsh.model.mesh.getElementProperties(11)  # (name, dim, order, n, local coords, ...)
+            ref = np.array(props[4]).reshape(-1, 3)
+            for k, (a, b) in enumerate(TET10_EDGES):
+                np.testing.assert_allclose(ref[4 + k], 0.5 * (ref[a] + ref[b]))
+        finally:
+            gmsh.finalize()
+
+
+class Straightening(unittest.TestCase):
+    def test_bow_of_a_circle(self):
+        # exact: three points of a circle of radius 5 spanning 60 degrees
+        from patient.straightening import bow
+        R, h = 5.0, math.radians(30)
+        p = [np.array([R * math.sin(a), R * (1 - math.cos(a)), 0.0]) for a in (-h, 0.0, h)]
+        b = bow(*p)
+        self.assertAlmostEqual(b["radius"], R, places=12)
+        self.assertAlmostEqual(b["chord"], 2 * R * math.sin(h), places=12)
+        self.assertAlmostEqual(b["sagitta"], R * (1 - math.cos(h)), places=12)
+        self.assertEqual(bow(np.zeros(3), np.array([1.0, 0, 0]), np.array([2.0, 0, 0]))["radius"], math.inf)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
