@@ -149,16 +149,16 @@ BeamScene beam_scene_from(const Node& root) {
                    "connectors", "elements_per_strut", "elements_per_connector", "centerline", "start"});
     g->choice("type", {"corrugated_rings"});
     StentParameters p;
-    p.rings = static_cast<int>(g->integer_or("rings", p.rings, 1));
-    p.crowns = static_cast<int>(g->integer_or("crowns", p.crowns, 2));
+    p.rings = static_cast<int>(g->integer_or("rings", p.rings, 1, 1000));  // 1000 rings: a 1.5 m stent
+    p.crowns = static_cast<int>(g->integer_or("crowns", p.crowns, 2, 1000));
     p.crimped_diameter = g->positive_or("crimped_diameter", p.crimped_diameter);
     p.strut_height = g->positive_or("strut_height", p.strut_height);
     p.ring_pitch = g->positive_or("ring_pitch", p.ring_pitch);
     p.connectors = static_cast<int>(g->integer_or("connectors", p.connectors, 0));
     if (p.connectors > p.crowns) g->child("connectors").fail("at most `crowns` connectors");
-    p.elements_per_strut = static_cast<int>(g->integer_or("elements_per_strut", p.elements_per_strut, 1));
+    p.elements_per_strut = static_cast<int>(g->integer_or("elements_per_strut", p.elements_per_strut, 1, 100));
     p.elements_per_connector =
-        static_cast<int>(g->integer_or("elements_per_connector", p.elements_per_connector, 1));
+        static_cast<int>(g->integer_or("elements_per_connector", p.elements_per_connector, 1, 100));
     p.start = g->number_or("start", -1);
     // centerline: {file} | {points}: the same key shape as balloon/artery.mesh.centerline, so
     // one centerline file places stent and balloon on the same curved axis (paper §2.4)

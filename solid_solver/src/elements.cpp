@@ -5,14 +5,6 @@
 
 namespace angio::solid {
 
-int num_nodes(ElemType t) {
-  switch (t) {
-    case ElemType::Hex8: return 8;
-    case ElemType::Tet4: return 4;
-    case ElemType::Tet10: return 10;
-  }
-  return 0;
-}
 int num_nodes(FaceType t) { return contact::num_nodes(to_contact(t)); }
 int num_corners(FaceType t) { return contact::num_corners(to_contact(t)); }
 const char* name(ElemType t) {
@@ -154,17 +146,21 @@ const std::vector<LocalFace>& local_faces(ElemType t) {
 }
 
 namespace {
-// Fixed-size implementation (NN nodes) of element_internal; dN/dxi at the Gauss points is cached.
-template <int NN>
-bool element_internal_fixed(ElemType t, const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud, const NeoHooke& mat,
+// Fixed-size implementation of element_internal for element type T; dN/dxi at the Gauss points is
+// cached per element type (not per node count: two types with the same number of nodes, e.g. a
+// future wedge or serendipity element, must not share a cache).
+template <ElemType T>
+bool element_internal_fixed(const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud, const NeoHooke& mat,
                             const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
                             ElementStress* out, const ViscousHistory* visc) {
+  constexpr int NN = num_nodes(T);
+  constexpr ElemType t = T;
   using MatN3 = Eigen::Matrix<double, NN, 3>;
   using VecF = Eigen::Matrix<double, 3 * NN, 1>;
   using MatK = Eigen::Matrix<double, 3 * NN, 3 * NN>;
   using MatB = Eigen::Matrix<double, 6, 3 * NN>;
   const auto& rule = volume_rule(t);
-  static const std::vector<MatN3> dNq = [&] {
+  static const std::vector<MatN3> dNq = [] {
     std::vector<MatN3> v;
     Eigen::VectorXd N;
     Eigen::MatrixXd dN;
@@ -243,9 +239,9 @@ bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixX
                       const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
                       ElementStress* out, const ViscousHistory* visc) {
   switch (t) {
-    case ElemType::Hex8: return element_internal_fixed<8>(t, X, u, mat, fibers, f, K, out, visc);
-    case ElemType::Tet4: return element_internal_fixed<4>(t, X, u, mat, fibers, f, K, out, visc);
-    case ElemType::Tet10: return element_internal_fixed<10>(t, X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Hex8: return element_internal_fixed<ElemType::Hex8>(X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Tet4: return element_internal_fixed<ElemType::Tet4>(X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Tet10: return element_internal_fixed<ElemType::Tet10>(X, u, mat, fibers, f, K, out, visc);
   }
   return false;
 }

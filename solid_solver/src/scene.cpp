@@ -1,6 +1,7 @@
 #include "angio/solid/scene.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
 
@@ -56,6 +57,36 @@ Axis read_axis(const Node& parent, const Vec3d& default_origin) {
     }
   }
   return a;
+}
+
+int shells(const TubeSpec& t) {
+  int n = 0;
+  for (const auto& l : t.layers) n += l.n_radial;
+  return n;
+}
+
+// A generated mesh is refused before it is allocated when its assembled tangent alone would not fit
+// in the memory available now: 3 DOFs per node, ~81 block-rows of neighbours (hex8) of 3 x 3 values
+// and column indices, i.e. ~3 kB per DOF, before any factorization fill. Only a lower bound: a run
+// that passes may still need several times more for a direct solver.
+void check_memory(const Node& mesh, double nodes) {
+  const double dofs = 3.0 * nodes, bytes = dofs * 81.0 * 3.0 * (8.0 + 4.0);
+  double avail = 0.0;
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char key[64];
+    double kb = 0;
+    while (std::fscanf(f, "%63s %lf kB\n", key, &kb) == 2)
+      if (std::string(key) == "MemAvailable:") avail = kb * 1024.0;
+    std::fclose(f);
+  }
+  if (avail > 0 && bytes > avail) {
+    char msg[256];
+    std::snprintf(msg, sizeof msg,
+                  "a mesh that fits in memory: %.3g nodes (%.3g DOFs) need at least %.3g GB for the tangent "
+                  "alone, %.3g GB are available",
+                  nodes, dofs, bytes / 1e9, avail / 1e9);
+    mesh.fail(msg);
+  }
 }
 
 // mesh: {generator: tube, ...} or {file: x.msh, ...}; returns the mesh with part-prefixed surfaces.
@@ -136,8 +167,8 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   t.surface_prefix = prefix;
   t.length = mesh.positive("length");
   const double ro = 0.5 * mesh.positive("outer_diameter");
-  t.n_circ = int(mesh.integer("n_circ", 3));
-  t.n_axial = int(mesh.integer("n_axial", 1));
+  t.n_circ = int(mesh.integer("n_circ", 3, 100000));
+  t.n_axial = int(mesh.integer("n_axial", 1, 1000000));
   if (mesh.has("center")) t.center = v3(mesh.vec3("center"));
   double wall = 0.0;
   if (layered) {
@@ -149,7 +180,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
       TubeLayer tl;
       tl.name = l.string("name");
       tl.thickness = l.positive("thickness");
-      tl.n_radial = int(l.integer_or("n_radial", 1, 1));
+      tl.n_radial = int(l.integer_or("n_radial", 1, 1, 10000));
       wall += tl.thickness;
       t.layers.push_back(tl);
     }
@@ -184,6 +215,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   }
   axis = Axis{t.center, Vec3d::UnitZ()};
   length = t.length;
+  check_memory(mesh, double(t.n_circ) * (t.n_axial + 1.0) * (shells(t) + 1.0));
   try {
     return make_tube(t);
   } catch (const std::runtime_error& e) {

@@ -2,7 +2,11 @@
 // names the file, the key path and what was expected (issue 2, item 5).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <string>
 
 #include "angio/scene/load_curve.hpp"
@@ -93,7 +97,7 @@ TEST(Scene, TimeSettings) {
   EXPECT_DOUBLE_EQ(t.end, 2.0);
   EXPECT_EQ(t.steps, 100);
   EXPECT_DOUBLE_EQ(t.min_step, 0.02 / 1024.0);
-  expect_error([] { time_settings(inline_scene("time: {end: 1, steps: 0}")); }, {"time.steps", ">= 1"});
+  expect_error([] { time_settings(inline_scene("time: {end: 1, steps: 0}")); }, {"time.steps", "an integer in 1..1000000"});
   expect_error([] { time_settings(inline_scene("time: {start: 2, end: 1, steps: 3}")); }, {"time.end"});
   // stops: the load-curve corners strictly inside (start, end), sorted, each once
   const TimeSettings c = time_settings(inline_scene(
@@ -109,4 +113,42 @@ TEST(Scene, TimeSettings) {
                {"time.adaptive", "easy"});
   expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 0}}")); },
                {"time.adaptive.easy_iterations"});
+}
+
+// A key given twice in one map is refused with both lines (yaml-cpp alone reads the first one).
+TEST(Scene, DuplicateKeysAreRejected) {
+  const std::string path = ::testing::TempDir() + "dup_" + std::to_string(::getpid()) + ".yaml";
+  {
+    std::ofstream f(path);
+    f << "time: {end: 1.0, steps: 10}\nstent:\n  material: {E: 1.0}\n  material: {E: 2.0}\n";
+  }
+  expect_error([&] { load_scene(path); }, {path, "stent.material", "twice", "lines 3 and 4"});
+  {
+    std::ofstream f(path);
+    f << "time: {end: 1.0, steps: 10}\nload_curves:\n  p: [[0, 0], [1, 1]]\ntime: {end: 2.0}\n";
+  }
+  expect_error([&] { load_scene(path); }, {"time", "lines 1 and 4"});
+  std::remove(path.c_str());
+}
+
+// A typo names the nearest valid key; an unrelated word does not get a suggestion.
+TEST(Scene, UnknownKeySuggestsTheNearest) {
+  const Node n = inline_scene("stent: {materail: {E: 1}}");
+  expect_error([&] { n.child("stent").check_keys({"material", "section", "generator"}); },
+               {"inline.yaml", "stent.materail", "unknown key", "did you mean `material`?"});
+  try {
+    n.child("stent").check_keys({"rings", "crowns"});
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).find("did you mean"), std::string::npos) << e.what();
+  }
+}
+
+// Integers are range-checked before callers cast them to int (4294967296 would wrap to 0).
+TEST(Scene, IntegersOutsideIntAreRejected) {
+  const Node n = inline_scene("time: {end: 1.0, steps: 4294967296}\nbig: {k: 2147483648, ok: 2147483647}");
+  expect_error([&] { time_settings(n); }, {"time.steps", "expected an integer in 1..1000000", "4294967296"});
+  expect_error([&] { n.child("big").integer("k"); }, {"big.k", "expected an integer", "2147483648"});
+  EXPECT_EQ(n.child("big").integer("ok"), 2147483647L);
+  expect_error([&] { n.child("big").integer("ok", 0, 100); }, {"big.ok", "an integer in 0..100"});
 }

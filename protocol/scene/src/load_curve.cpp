@@ -82,7 +82,7 @@ TimeSettings time_settings(const Node& root) {
   ts.start = t->number_or("start", 0.0);
   ts.end = t->number("end");
   if (!(ts.end > ts.start)) t->child("end").fail("a time larger than time.start");
-  ts.steps = static_cast<int>(t->integer("steps", 1));
+  ts.steps = static_cast<int>(t->integer("steps", 1, 1000000));  // more is a typo, not a run
   const double nominal = (ts.end - ts.start) / ts.steps;
   ts.min_step = t->positive_or("min_step", nominal / 1024.0);
   ts.max_cuts = static_cast<int>(t->integer_or("max_cuts", 10, 0));

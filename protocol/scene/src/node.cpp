@@ -1,6 +1,8 @@
 #include "angio/scene/node.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -137,18 +139,23 @@ double Node::in_range(const std::string& key, double lo, double hi) const {
   return v;
 }
 
-long Node::integer(const std::string& key, long min) const {
-  std::string what = min == std::numeric_limits<long>::min()
-                         ? std::string("an integer")
-                         : "an integer >= " + std::to_string(min);
+long Node::integer(const std::string& key, long min, long max) const {
+  constexpr long imin = std::numeric_limits<int>::min(), imax = std::numeric_limits<int>::max();
+  std::string what = "an integer";
+  if (min != imin && max != imax)
+    what += " in " + std::to_string(min) + ".." + std::to_string(max);
+  else if (min != imin)
+    what += " >= " + std::to_string(min) + (max == imax ? " (at most " + std::to_string(imax) + ")" : "");
+  else if (max != imax)
+    what += " <= " + std::to_string(max);
   Node c = child(key, what);
-  long v = c.as_integer();
-  if (v < min) c.fail(what);
+  const long v = c.as_integer();
+  if (v < min || v > max) c.fail(what);
   return v;
 }
 
-long Node::integer_or(const std::string& key, long fallback, long min) const {
-  return has(key) ? integer(key, min) : fallback;
+long Node::integer_or(const std::string& key, long fallback, long min, long max) const {
+  return has(key) ? integer(key, min, max) : fallback;
 }
 
 bool Node::boolean(const std::string& key) const {
@@ -211,15 +218,57 @@ void Node::check_keys(std::initializer_list<const char*> allowed) const {
   check_keys(std::vector<std::string>(allowed.begin(), allowed.end()));
 }
 
+namespace {
+// Levenshtein distance (insertions, deletions, substitutions), for "did you mean".
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// Every map of the document: a key given twice is an error naming both lines.
+void check_unique_keys(const YAML::Node& n, const std::string& file, const std::string& path) {
+  if (n.IsMap()) {
+    std::map<std::string, int> first;
+    for (const auto& kv : n) {
+      const std::string k = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      const std::string sub = path.empty() ? k : path + "." + k;
+      const int line = kv.first.Mark().line + 1;
+      if (const auto it = first.find(k); it != first.end())
+        throw SceneError(file + ": " + sub + ": expected each key once in a map, got it twice (lines " +
+                         std::to_string(it->second) + " and " + std::to_string(line) + ")");
+      first.emplace(k, line);
+      check_unique_keys(kv.second, file, sub);
+    }
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) check_unique_keys(n[i], file, path + "[" + std::to_string(i) + "]");
+  }
+}
+}  // namespace
+
 void Node::check_keys(const std::vector<std::string>& allowed) const {
   if (!node_.IsMap()) fail("a map");
   std::set<std::string> ok(allowed.begin(), allowed.end());
   for (const auto& kv : node_) {
     std::string k = kv.first.as<std::string>();
     if (!ok.count(k)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw SceneError(file_ + ": " + child_path(k) + ": unknown key, expected one of: " + list);
+      std::string list, nearest;
+      std::size_t best = std::max<std::size_t>(2, k.size() / 3) + 1;
+      for (const auto& a : allowed) {
+        list += (list.empty() ? "" : ", ") + a;
+        if (const std::size_t d = edit_distance(k, a); d < best) best = d, nearest = a;
+      }
+      throw SceneError(file_ + ": " + child_path(k) + ": unknown key, expected one of: " + list +
+                       (nearest.empty() ? "" : "; did you mean `" + nearest + "`?"));
     }
   }
 }
@@ -236,6 +285,7 @@ Node load_scene(const std::string& path) {
   }
   Node n(root, path, "");
   if (!root.IsMap()) n.fail("a YAML map at the top level");
+  check_unique_keys(root, path, "");
   return n;
 }
 

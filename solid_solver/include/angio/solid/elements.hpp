@@ -22,7 +22,14 @@ inline contact::FaceKind to_contact(FaceType t) {
   return contact::FaceKind(int(t));
 }
 
-int num_nodes(ElemType t);
+constexpr int num_nodes(ElemType t) {
+  switch (t) {
+    case ElemType::Hex8: return 8;
+    case ElemType::Tet4: return 4;
+    case ElemType::Tet10: return 10;
+  }
+  return 0;
+}
 int num_nodes(FaceType t);
 int num_corners(FaceType t);
 const char* name(ElemType t);

@@ -53,9 +53,12 @@ class Node {
   double non_negative(const std::string& key) const;                  // >= 0
   double non_negative_or(const std::string& key, double fallback) const;
   double in_range(const std::string& key, double lo, double hi) const;  // lo <= v <= hi
-  long integer(const std::string& key, long min = std::numeric_limits<long>::min()) const;
-  long integer_or(const std::string& key, long fallback,
-                  long min = std::numeric_limits<long>::min()) const;
+  // Integers are range-checked before any caller casts them: by default to the range of int, so a
+  // count such as `steps: 4294967296` is refused here instead of wrapping around to 0 in an int.
+  long integer(const std::string& key, long min = std::numeric_limits<int>::min(),
+               long max = std::numeric_limits<int>::max()) const;
+  long integer_or(const std::string& key, long fallback, long min = std::numeric_limits<int>::min(),
+                  long max = std::numeric_limits<int>::max()) const;
   bool boolean(const std::string& key) const;
   bool boolean_or(const std::string& key, bool fallback) const;
   std::string string(const std::string& key) const;
@@ -74,7 +77,8 @@ class Node {
   std::array<double, 3> as_vec3() const;
   std::vector<double> as_numbers() const;
 
-  // Rejects keys not in `allowed` (catches typos such as "pressur:"), naming the offending key.
+  // Rejects keys not in `allowed` (catches typos such as "pressur:"), naming the offending key and
+  // the nearest allowed one ("did you mean `pressure`?").
   void check_keys(std::initializer_list<const char*> allowed) const;
   void check_keys(const std::vector<std::string>& allowed) const;
 
@@ -90,7 +94,8 @@ class Node {
   std::string path_;
 };
 
-// Loads and parses a scene file; throws SceneError naming the file on I/O or syntax errors.
+// Loads and parses a scene file; throws SceneError naming the file on I/O or syntax errors, and on a
+// key given twice in one map (yaml-cpp would silently read the first, the launcher the last).
 Node load_scene(const std::string& path);
 
 // Resolves a path given in a scene relative to the scene file's directory (absolute paths pass).
