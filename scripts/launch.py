@@ -361,9 +361,26 @@ class Proc:
                 pass
 
 
+def last_error_line(log_path, limit=400):
+    """The last ERROR line of a process's log (its own diagnosis, e.g. which participant went
+    silent), cut to one readable line; '' if there is none."""
+    try:
+        with open(log_path, "rb") as f:
+            f.seek(max(0, os.path.getsize(log_path) - 65536))
+            lines = f.read().decode("utf-8", "replace").splitlines()
+    except OSError:
+        return ""
+    for ln in reversed(lines):
+        if "ERROR" in ln:
+            ln = " ".join(ln.split())
+            return ln if len(ln) <= limit else ln[:limit - 3] + "..."
+    return ""
+
+
 def stop_all(procs, grace=5.0):
     for pr in procs:
         pr.signal(signal.SIGTERM)
+        pr.signal(signal.SIGCONT)  # a stopped (frozen) process acts on the SIGTERM only once continued
     deadline = time.time() + grace
     for pr in procs:
         try:
@@ -504,7 +521,8 @@ def main():
         return 130
     if failed:
         name, rc = failed
-        print(f"launch: error: {name} exited with code {rc} after {wall:.1f} s "
+        why = last_error_line(run_dir / f"{name}.log")
+        print(f"launch: error: {name} exited with code {rc} after {wall:.1f} s{': ' + why if why else ''} "
               f"(log: {run_dir / (name + '.log')}); the other processes were stopped", file=sys.stderr)
         # 2 is every executable's "bad scene or mesh" (the message names the file and key): passed on
         # unchanged, so that a bad scene is exit code 2 from the launcher as from the solvers

@@ -116,6 +116,10 @@ int run(const cli::Parser& args) {
         LOG_DEBUG("while shutting down: " << e.what());
       }
     };
+    // a participant that is silent (frozen or dead) would hold each of these for a full timeout
+    const auto grace = std::min(timeout, std::chrono::milliseconds(2000));
+    beam_ch.set_timeout(grace);
+    solid_ch.set_timeout(grace);
     quietly([&] { beam.finish(); });
     quietly([&] { solid.finish(); });
     return 3;

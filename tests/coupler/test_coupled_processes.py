@@ -7,7 +7,10 @@
    iteration history exactly (same iterations, residuals and relaxation factors per step).
 3. a participant that dies makes the launcher stop everything and name it (non-zero exit).
 4. a coupler without participants fails with a timeout error instead of hanging.
+5. a frozen participant (SIGSTOP) stops the run within --timeout + a few seconds, the coupler names
+   it, the launcher passes the coupler's diagnosis on, the summary says failed, nothing is left.
 """
+import json
 import csv
 import signal
 import subprocess
@@ -99,5 +102,39 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r4.returncode != 0 and "did not answer" in r4.stderr,
           f"coupler alone fails with a timeout error (rc {r4.returncode}): {r4.stderr.strip()}")
     check(time.time() - t0 < 30, f"within the timeout ({time.time() - t0:.1f} s)")
+
+    # 5. a frozen participant: the coupler, which waits for it, names it within --timeout; the other
+    # participant waits 2 x --timeout before giving up, so it does not pre-empt the diagnosis
+    cmd = LAUNCH + [str(SCENE), "--run-dir", str(tmp / "frozen"), "--build-dir", str(BIN.parent),
+                    "--run-id", "freeze-me", "--timeout", "6",
+                    "--beam-cmd", f"{spring} --role beam --delay 0.5", "--solid-cmd", f"{spring} --role solid"]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)
+    beam_pids = subprocess.run(["pgrep", "-f", "role beam --delay 0.5.*freeze-me"], capture_output=True,
+                               text=True).stdout.split()
+    check(len(beam_pids) == 1, f"the beam participant of the run is found ({beam_pids})")
+    for pid in beam_pids:
+        subprocess.run(["kill", "-STOP", pid])
+    t0 = time.time()
+    try:
+        out, err = p.communicate(timeout=60)
+        took = time.time() - t0
+        check(p.returncode not in (0, None), f"frozen beam: the launcher fails (rc {p.returncode})")
+        check(took < 6 + 5, f"frozen beam: stopped within --timeout + 5 s ({took:.1f} s)")
+        check("coupler exited with code 3" in err and "beam participant did not answer" in err,
+              f"frozen beam: the launcher names the silent participant: {err.strip()[-400:]}")
+        summ = json.loads((tmp / "frozen" / "coupling_summary.json").read_text())
+        check(summ.get("status") == "failed" and "beam" in summ.get("error", ""),
+              f"frozen beam: coupling_summary.json says failed and names it ({summ.get('status')})")
+    except subprocess.TimeoutExpired:
+        p.kill()
+        check(False, "frozen beam: the launcher ends within 60 s")
+    for pid in beam_pids:
+        subprocess.run(["kill", "-CONT", pid])
+    time.sleep(1.0)
+    left = subprocess.run(["pgrep", "-f", "freeze-me"], capture_output=True, text=True).stdout.split()
+    check(not left, f"frozen beam: no process of the run is left ({left})")
+    for pid in left:
+        subprocess.run(["kill", "-KILL", pid])
 
 sys.exit(1 if failures else 0)

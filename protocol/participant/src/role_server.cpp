@@ -50,9 +50,13 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
           return 4;
         }
       }
-      if (Clock::now() - last_heard > o.timeout) {
+      // The coupler itself waits up to --timeout for the other participant before it gives up and
+      // names it; waiting twice that (plus the coupler's shutdown grace) leaves the diagnosis to
+      // the coupler, which knows who went silent. A frozen or dead coupler is caught earlier by
+      // its liveliness token above.
+      if (Clock::now() - last_heard > 2 * o.timeout + std::chrono::seconds(5)) {
         LOG_ERROR("no request from the coupler for " << seconds_since(last_heard)
-                                                     << " s (--timeout); exiting");
+                                                     << " s (2 x --timeout + 5 s); exiting");
         return 4;
       }
       continue;

@@ -46,6 +46,9 @@ class Channel {
   msg::Buffer call(const std::string& verb, const Build& build);
   // True while the participant's liveliness token is visible.
   bool alive(std::chrono::milliseconds timeout) const;
+  // The reply timeout of later calls (the coupler's error path shortens it: a participant that went
+  // silent once must not hold the shutdown for a second full timeout).
+  void set_timeout(std::chrono::milliseconds timeout) { timeout_ = timeout; }
 
   const ExchangeTiming& timing() const { return timing_; }
   ExchangeTiming& timing() { return timing_; }
