@@ -1,0 +1,322 @@
+#!/usr/bin/env python3
+"""Error against run time for a coupled scene (issue 17): runs the scene at a ladder of settings for
+each discretization knob and reports, per knob and output, the error against the finest run of the
+ladder (or its Richardson extrapolation when three runs show a clean convergence order).
+
+  scripts/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,beam]
+                            [--tol 0.01] [--out-dir DIR] [--build-dir DIR]
+
+Knobs (each ladder holds the scene's own setting, "shipped"; the others are kept as shipped):
+  steps         time.steps x 1/4, 1/2, 1, 2, 4 (fixed steps: `time.adaptive` is switched off)
+  coupling_tol  coupling.rel_tol 1e-2, 3e-3, 1e-3, 3e-4, 1e-4
+  newton_tol    solid.newton.rtol 1e-4, 1e-6, 1e-8, 1e-10
+  mesh          balloon/artery divisions x 1, 1.5, 2 per direction (tube generators; a patient
+                artery: patient.mesh.size / 1, 1.5, 2)
+  beam          stent.generator.elements_per_strut (and per connector) 2, 3, 4, 6
+--quick: steps x 1/2, 1, 2; coupling_tol 1e-2, 1e-3, 1e-4; beam 2, 3 (a ladder CI can afford on a
+short scene).
+
+Outputs of each run (scripts/report.py's results.json): stent diameter at peak and final, recoil
+(%), dogboning (%), and for an artery the max and 99th-percentile first principal stress per layer
+at peak and after. Error of an output = |q - q_ref| / |q_ref|. Richardson: with the three finest runs
+of a geometric ladder (ratio r), the observed order p = ln(|q1 - q2| / |q2 - q3|) / ln r; when the
+differences keep their sign and 0.5 <= p <= 8, q_ref = q3 + (q3 - q2) / (r^p - 1) and p is reported.
+
+Written to OUT_DIR: work_precision.json and .csv (every run: knob, level, wall time, outputs,
+errors), work_precision.png (error against wall time, log-log, one panel per output, one curve per
+knob) and a verdict (also printed): which knob dominates the error at the shipped settings, and per
+knob the cheapest setting that keeps every output within --tol.
+"""
+import argparse
+import copy
+import csv
+import hashlib
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import yaml
+
+from scene_variant import launch_command, variant_scene
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
+
+
+# ------------------------------------------------------------------------------------------------
+# knobs: (levels, apply(scene, level), value in the shipped scene, label, ratio for Richardson)
+def _steps_levels(quick):
+    return [0.5, 1.0, 2.0] if quick else [0.25, 0.5, 1.0, 2.0, 4.0]
+
+
+def _set_steps(s, f):
+    t = s["time"]
+    t["steps"] = max(1, int(round(t["steps"] * f)))
+    t.pop("adaptive", None)
+
+
+def _set_coupling_tol(s, v):
+    s.setdefault("coupling", {})["rel_tol"] = v
+
+
+def _set_newton_tol(s, v):
+    s.setdefault("solid", {}).setdefault("newton", {})["rtol"] = v
+
+
+def _set_mesh(s, f):
+    for part in ("balloon", "artery"):
+        m = s.get(part, {}).get("mesh")
+        if isinstance(m, dict) and m.get("generator") == "tube":
+            for k in ("n_circ", "n_axial"):
+                if k in m:
+                    m[k] = max(3, int(round(m[k] * f)))
+            for layer in m.get("layers", []):
+                layer["n_radial"] = max(1, int(round(layer.get("n_radial", 1) * f)))
+    pm = s.get("patient", {}).get("mesh")
+    if isinstance(pm, dict):
+        pm["size"] = pm.get("size", 0.8) / f
+
+
+def _set_beam(s, n):
+    g = s["stent"]["generator"]
+    g["elements_per_strut"] = n
+    g["elements_per_connector"] = n
+
+
+def knobs(scene, quick):
+    t = scene.get("time", {})
+    c = scene.get("coupling", {})
+    nw = scene.get("solid", {}).get("newton", {})
+    g = scene.get("stent", {}).get("generator", {})
+    out = {
+        "steps": (_steps_levels(quick), _set_steps, 1.0, "load steps x", 2.0),
+        "coupling_tol": ([1e-2, 1e-3, 1e-4] if quick else [1e-2, 3e-3, 1e-3, 3e-4, 1e-4], _set_coupling_tol,
+                         c.get("rel_tol", 1e-3), "coupling rel_tol", None),
+        "newton_tol": ([1e-4, 1e-6, 1e-8, 1e-10], _set_newton_tol, nw.get("rtol", 1e-8), "solid Newton rtol", 100.0),
+        "mesh": ([1.0, 1.5, 2.0], _set_mesh, 1.0, "mesh refinement x", None),
+        "beam": ([2, 3] if quick else [2, 3, 4, 6], _set_beam, g.get("elements_per_strut", 3),
+                 "beam elements per strut", None),
+    }
+    if "generator" not in scene.get("stent", {}):
+        out.pop("beam")
+    return out
+
+
+def is_finer(knob, a, b):
+    """True when level a is a finer setting than b."""
+    return a < b if knob in ("coupling_tol", "newton_tol") else a > b
+
+
+# ------------------------------------------------------------------------------------------------
+def outputs_of(run_dir):
+    """The outputs a user reads, from report.py's results.json (None where absent)."""
+    subprocess.run([PYTHON, os.path.join(ROOT, "scripts", "report.py"), run_dir], capture_output=True)
+    try:
+        res = json.load(open(os.path.join(run_dir, "results.json")))
+    except (OSError, ValueError):
+        return {}
+    out = {}
+    art = res.get("artery")
+    st = res.get("stent", {})
+    if art:
+        ph = art.get("phases", {})
+        out["D_peak"] = ph.get("peak", {}).get("stent_diameter")
+        out["D_final"] = ph.get("after", {}).get("stent_diameter")
+        for phase in ("peak", "after"):
+            for layer, v in (ph.get(phase, {}).get("layers") or {}).items():
+                out[f"{layer}_max_{phase}"] = v.get("max_principal_stress")
+                out[f"{layer}_p99_{phase}"] = v.get("p99_principal_stress")
+    else:
+        out["D_peak"] = st.get("max")
+        out["D_final"] = st.get("final")
+    out["recoil_percent"] = st.get("recoil_percent")
+    out["dogboning_percent"] = st.get("dogboning_max_percent")
+    return {k: v for k, v in out.items() if isinstance(v, (int, float)) and math.isfinite(v)}
+
+
+def run_scene(base_path, scene, out_dir, build_dir, cache):
+    text = yaml.safe_dump(scene, sort_keys=True)
+    key = hashlib.sha1(text.encode()).hexdigest()[:12]
+    if key in cache:
+        return cache[key]
+    run_dir = os.path.join(out_dir, f"run-{key}")
+    subprocess.run(["rm", "-rf", run_dir])
+    with variant_scene(base_path, scene, f"wp_{key}", "generated by scripts/work_precision.py") as path:
+        t0 = time.time()
+        with open(run_dir + ".out", "w") as log:
+            rc = subprocess.call(launch_command(path, run_dir, build_dir), stdout=log, stderr=subprocess.STDOUT)
+        wall = time.time() - t0
+    r = {"run": key, "status": "ok" if rc == 0 else f"exit {rc}", "wall_s": wall,
+         "outputs": outputs_of(run_dir) if rc == 0 else {}}
+    cache[key] = r
+    return r
+
+
+# ------------------------------------------------------------------------------------------------
+def richardson(levels, values, ratio):
+    """(q_ref, order) from the three finest runs of a geometric ladder, or (None, None)."""
+    if ratio is None or len(values) < 3 or any(v is None for v in values[-3:]):
+        return None, None
+    q1, q2, q3 = values[-3:]
+    d1, d2 = q2 - q1, q3 - q2
+    if d1 == 0 or d2 == 0 or (d1 > 0) != (d2 > 0) or abs(d2) >= abs(d1):
+        return None, None
+    p = math.log(abs(d1) / abs(d2)) / math.log(ratio)
+    if not 0.5 <= p <= 8:
+        return None, None
+    return q3 + d2 / (ratio ** p - 1.0), p
+
+
+def analyse(knob_runs, tol):
+    """Errors per run and output, the reference used, and the verdict."""
+    verdict = {"dominant_at_shipped": None, "cheapest_within_tol": {}, "shipped_errors": {}, "orders": {}}
+    worst = (0.0, None)
+    for knob, k in knob_runs.items():
+        runs = [r for r in k["runs"] if r["status"] == "ok"]
+        runs.sort(key=lambda r: r["level"], reverse=is_finer(knob, 0, 1))  # coarse -> fine
+        if not runs:
+            continue
+        names = sorted(set().union(*(r["outputs"] for r in runs)))
+        for name in names:
+            vals = [r["outputs"].get(name) for r in runs]
+            q_ext, p = richardson([r["level"] for r in runs], vals, k["ratio"])
+            ref = q_ext if q_ext is not None else vals[-1]
+            if p is not None:
+                verdict["orders"].setdefault(knob, {})[name] = p
+            for r, v in zip(runs, vals):
+                if v is not None and ref not in (None, 0):
+                    r.setdefault("errors", {})[name] = abs(v - ref) / abs(ref)
+                    r.setdefault("reference", {})[name] = "richardson" if q_ext is not None else "finest"
+        shipped = [r for r in runs if r["shipped"]]
+        if shipped:
+            e = shipped[0].get("errors", {})
+            verdict["shipped_errors"][knob] = e
+            m = max(e.values(), default=0.0)
+            if m > worst[0]:
+                worst = (m, knob)
+        ok = [r for r in runs if r.get("errors") and max(r["errors"].values()) <= tol]
+        if ok:
+            best = min(ok, key=lambda r: r["wall_s"])
+            verdict["cheapest_within_tol"][knob] = {"level": best["level"], "wall_s": best["wall_s"]}
+    verdict["dominant_at_shipped"] = worst[1]
+    return verdict
+
+
+def plot(knob_runs, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+    names = sorted(set().union(*(r.get("errors", {}) for k in knob_runs.values() for r in k["runs"])))
+    if not names:
+        return False
+    cols = min(3, len(names))
+    rows = math.ceil(len(names) / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.4 * rows), squeeze=False)
+    for ax, name in zip(axes.flat, names):
+        for i, (knob, k) in enumerate(knob_runs.items()):
+            pts = [(r["wall_s"], r["errors"][name], r["shipped"]) for r in k["runs"]
+                   if r.get("errors", {}).get(name, 0) > 0]
+            if not pts:
+                continue
+            pts.sort()
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", color=f"C{i}", label=knob)
+            for w, e, shipped in pts:
+                if shipped:
+                    ax.loglog([w], [e], "*", color=f"C{i}", markersize=12)
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())  # a narrow time range: no clutter
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("wall time (s)")
+        ax.set_ylabel("relative error")
+        ax.grid(True, which="both", alpha=0.3)
+    axes.flat[0].legend(fontsize=7)
+    for ax in list(axes.flat)[len(names):]:
+        ax.axis("off")
+    fig.suptitle("error against run time (star: shipped setting)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return True
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scene")
+    ap.add_argument("--quick", action="store_true", help="coarse ladders (CI)")
+    ap.add_argument("--knobs", help="comma-separated subset of steps,coupling_tol,newton_tol,mesh,beam")
+    ap.add_argument("--tol", type=float, default=0.01, help="relative error a setting must keep (default 1 %%)")
+    ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "work_precision"))
+    ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
+    a = ap.parse_args()
+    if not (a.tol > 0 and math.isfinite(a.tol)):
+        print(f"work_precision: --tol: expected a positive number, got {a.tol}", file=sys.stderr)
+        return 2
+    base_path = os.path.abspath(a.scene if os.path.isfile(a.scene) else os.path.join(ROOT, "configs", a.scene))
+    if not os.path.isfile(base_path):
+        print(f"work_precision: {a.scene}: no such scene", file=sys.stderr)
+        return 2
+    base = yaml.safe_load(open(base_path))
+    if not (isinstance(base, dict) and "stent" in base and ("balloon" in base or "artery" in base)):
+        print(f"work_precision: {base_path}: expected a coupled scene (stent and balloon/artery)", file=sys.stderr)
+        return 2
+    all_knobs = knobs(base, a.quick)
+    chosen = a.knobs.split(",") if a.knobs else (["steps", "coupling_tol", "beam"] if a.quick else list(all_knobs))
+    for k in chosen:
+        if k not in all_knobs:
+            print(f"work_precision: --knobs: unknown knob '{k}', expected some of {','.join(all_knobs)}", file=sys.stderr)
+            return 2
+    os.makedirs(a.out_dir, exist_ok=True)
+    cache = {}
+    knob_runs = {}
+    for k in chosen:
+        levels, apply, shipped, label, ratio = all_knobs[k]
+        if shipped not in levels:
+            levels = sorted(set(levels) | {shipped})
+        knob_runs[k] = {"label": label, "ratio": ratio, "runs": []}
+        for lv in levels:
+            s = copy.deepcopy(base)
+            if lv != shipped:  # the shipped setting is the base scene itself (adaptive steps included)
+                apply(s, lv)
+            print(f"[work_precision] {k} = {lv} ...", file=sys.stderr, flush=True)
+            r = dict(run_scene(base_path, s, a.out_dir, a.build_dir, cache))
+            r.update(level=lv, shipped=(lv == shipped))
+            knob_runs[k]["runs"].append(r)
+            print(f"[work_precision]   {r['status']}, {r['wall_s']:.1f} s", file=sys.stderr, flush=True)
+    verdict = analyse(knob_runs, a.tol)
+    doc = {"scene": base_path, "quick": a.quick, "tol": a.tol, "knobs": knob_runs, "verdict": verdict}
+    with open(os.path.join(a.out_dir, "work_precision.json"), "w") as f:
+        json.dump(doc, f, indent=1)
+    names = sorted(set().union(*(r["outputs"] for k in knob_runs.values() for r in k["runs"])))
+    with open(os.path.join(a.out_dir, "work_precision.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["knob", "level", "shipped", "status", "wall_s"] + names + [f"err_{n}" for n in names])
+        for k, kr in knob_runs.items():
+            for r in kr["runs"]:
+                w.writerow([k, r["level"], r["shipped"], r["status"], f"{r['wall_s']:.2f}"]
+                           + [r["outputs"].get(n, "") for n in names]
+                           + [r.get("errors", {}).get(n, "") for n in names])
+    png = os.path.join(a.out_dir, "work_precision.png")
+    have_png = plot(knob_runs, png)
+    print(f"scene {base_path}")
+    for k, kr in knob_runs.items():
+        for r in kr["runs"]:
+            e = r.get("errors", {})
+            worst = max(e.items(), key=lambda kv: kv[1]) if e else ("-", float("nan"))
+            print(f"  {k:<13}{str(r['level']):>8}{'*' if r['shipped'] else ' '} {r['status']:<8}{r['wall_s']:>8.1f} s"
+                  f"   worst error {worst[1]:.2e} ({worst[0]})")
+    dom = verdict["dominant_at_shipped"]
+    print(f"verdict: at the shipped settings the largest error comes from '{dom}'"
+          f" ({max(verdict['shipped_errors'].get(dom, {}).values(), default=0):.2e})" if dom else
+          "verdict: no knob changes the outputs measurably at the shipped settings")
+    for k, c in verdict["cheapest_within_tol"].items():
+        print(f"  cheapest {k} keeping every output within {100 * a.tol:g} %: {c['level']} ({c['wall_s']:.1f} s)")
+    for k, o in verdict["orders"].items():
+        print(f"  observed order ({k}): " + ", ".join(f"{n} {p:.2f}" for n, p in sorted(o.items())))
+    print(f"(runs in {a.out_dir}; work_precision.json/.csv{', work_precision.png' if have_png else ''})")
+    return 0 if all(r["status"] == "ok" for k in knob_runs.values() for r in k["runs"]) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""scripts/work_precision.py --quick in CI (issue 17) on a 4-step variant of the straight free
+expansion: every run of the quick ladders (load steps x 1/2, 1, 2; coupling rel_tol 1e-2, 1e-3,
+1e-4; beam elements per strut 2, 3) finishes, the JSON/CSV/PNG are written, the finest run of a
+ladder without a Richardson reference has zero error, and tightening the coupling tolerance brings
+the stent diameter closer to the reference (convergence in the coupling tolerance).
+Usage: test_work_precision_quick.py BIN_DIR
+"""
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[2]
+failures = []
+
+
+def check(cond, msg):
+    print(("ok   " if cond else "FAIL ") + msg)
+    if not cond:
+        failures.append(msg)
+
+
+bin_dir = Path(sys.argv[1]).resolve()
+with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
+    tmp = Path(tmp)
+    s = yaml.safe_load(open(ROOT / "configs" / "straight_free_expansion.yaml"))
+    s["time"] = {"end": 0.12, "steps": 4}  # 3 % of the inflation: the stent already in contact
+    scene = tmp / "wp_short.yaml"
+    yaml.safe_dump(s, open(scene, "w"), sort_keys=False)
+    out = tmp / "out"
+    r = subprocess.run(["/usr/bin/python3", str(ROOT / "scripts" / "work_precision.py"), str(scene), "--quick",
+                        "--out-dir", str(out), "--build-dir", str(bin_dir.parent)],
+                       capture_output=True, text=True, timeout=1200)
+    print(r.stdout[-4000:], r.stderr[-2000:])
+    check(r.returncode == 0, f"work_precision.py --quick exits 0 (got {r.returncode})")
+    doc = json.load(open(out / "work_precision.json"))
+    check(set(doc["knobs"]) == {"steps", "coupling_tol", "beam"}, f"three quick knobs ({sorted(doc['knobs'])})")
+    check((out / "work_precision.csv").stat().st_size > 0 and (out / "work_precision.png").stat().st_size > 0,
+          "CSV and PNG written")
+    for knob, k in doc["knobs"].items():
+        check(all(r["status"] == "ok" and "D_peak" in r["outputs"] for r in k["runs"]),
+              f"{knob}: every run finished with a stent diameter")
+        check(sum(r["shipped"] for r in k["runs"]) == 1, f"{knob}: the shipped setting is in the ladder")
+    ct = sorted(doc["knobs"]["coupling_tol"]["runs"], key=lambda r: -r["level"])  # 1e-2, 1e-3, 1e-4
+    e = [r["errors"]["D_peak"] for r in ct]
+    check(ct[-1]["reference"]["D_peak"] != "finest" or e[-1] == 0.0, "the finest run is the reference")
+    check(e[0] >= e[1], f"tighter coupling tolerance, smaller diameter error ({e[0]:.2e} >= {e[1]:.2e})")
+    check("verdict" in r.stdout, "a verdict is printed")
+
+print("FAILED: " + "; ".join(failures) if failures else "all passed")
+sys.exit(1 if failures else 0)
