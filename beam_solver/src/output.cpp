@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -45,6 +47,7 @@ std::vector<double> flat(const std::vector<Vec3>& v) {
   return out;
 }
 
+// a number in the XDMF text (the summary is written with nlohmann::json)
 std::string num(double v) {
   if (!std::isfinite(v)) return "null";
   std::ostringstream os;
@@ -189,11 +192,16 @@ std::string write_summary(const std::string& path, const BeamModel& m,
                           const std::vector<StepRecord>& steps, bool generated_stent,
                           const std::string& status, double newton_seconds,
                           long newton_iterations, const StepRecord& initial) {
-  std::ostringstream os;
-  os << "{\n  \"status\": \"" << status << "\",\n";
-  os << "  \"units\": {\"length\": \"mm\", \"force\": \"N\", \"moment\": \"N mm\", \"time\": \"s\"},\n";
-  os << "  \"num_nodes\": " << m.num_nodes() << ",\n  \"num_elements\": " << m.num_elements() << ",\n";
-  os << "  \"generated_stent\": " << (generated_stent ? "true" : "false") << ",\n";
+  using nlohmann::ordered_json;
+  // non-finite numbers (e.g. the NaN stent measures of a model that is not a generated stent)
+  // are written as null, never as NaN tokens
+  auto finite = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr); };
+  ordered_json j;
+  j["status"] = status;
+  j["units"] = {{"length", "mm"}, {"force", "N"}, {"moment", "N mm"}, {"time", "s"}};
+  j["num_nodes"] = m.num_nodes();
+  j["num_elements"] = m.num_elements();
+  j["generated_stent"] = generated_stent;
   const double D0 = initial.diameter;  // initial (crimped) diameter
   double Dmax = D0, tmax = 0;
   for (const auto& s : steps)
@@ -202,12 +210,16 @@ std::string write_summary(const std::string& path, const BeamModel& m,
       tmax = s.time;
     }
   const double Dfinal = steps.empty() ? D0 : steps.back().diameter;
-  os << "  \"diameter\": {\"initial\": " << num(D0) << ", \"max\": " << num(Dmax)
-     << ", \"time_of_max\": " << num(tmax) << ", \"final\": " << num(Dfinal)
-     << ", \"recoil\": " << num(Dmax - Dfinal) << ", \"recoil_percent\": "
-     << num(Dmax > 0 ? 100.0 * (Dmax - Dfinal) / Dmax : 0.0)
-     << ", \"definition\": \"2 x mean radial distance of all nodes from the device axis"
-     << (generated_stent ? " of the deformed stent (polyline through the ring centroids)" : "") << "\"},\n";
+  j["diameter"] = {
+      {"initial", finite(D0)},
+      {"max", finite(Dmax)},
+      {"time_of_max", finite(tmax)},
+      {"final", finite(Dfinal)},
+      {"recoil", finite(Dmax - Dfinal)},
+      {"recoil_percent", finite(Dmax > 0 ? 100.0 * (Dmax - Dfinal) / Dmax : 0.0)},
+      {"definition",
+       std::string("2 x mean radial distance of all nodes from the device axis") +
+           (generated_stent ? " of the deformed stent (polyline through the ring centroids)" : "")}};
   if (generated_stent && !steps.empty()) {
     // dogboning = (D_distal − D_central)/D_distal; foreshortening = (L0 − L)/L0
     double dbmax = -1e300, tdb = 0;
@@ -222,26 +234,31 @@ std::string write_summary(const std::string& path, const BeamModel& m,
       return a.diameter < b.diameter;
     });
     const auto& fin = steps.back();
-    const double initial_length = initial.length;
-    os << "  \"stent\": {\"length_initial\": " << num(initial_length) << ", \"length_at_max_diameter\": "
-       << num(pk.length) << ", \"length_final\": " << num(fin.length)
-       << ", \"foreshortening_at_max_diameter_percent\": " << num(100.0 * (initial_length - pk.length) / initial_length)
-       << ", \"foreshortening_final_percent\": " << num(100.0 * (initial_length - fin.length) / initial_length)
-       << ", \"distal_diameter_at_max\": " << num(pk.distal_diameter)
-       << ", \"central_diameter_at_max\": " << num(pk.central_diameter)
-       << ", \"dogboning_at_max_diameter_percent\": "
-       << num(100.0 * (pk.distal_diameter - pk.central_diameter) / pk.distal_diameter)
-       << ", \"dogboning_max_percent\": " << num(100.0 * dbmax) << ", \"time_of_dogboning_max\": " << num(tdb)
-       << ", \"axis_sagitta_initial\": " << num(initial.axis_sagitta)
-       << ", \"axis_sagitta_at_max_diameter\": " << num(pk.axis_sagitta)
-       << ", \"axis_sagitta_final\": " << num(fin.axis_sagitta)
-       << ", \"axis_radius_initial\": " << num(initial.axis_radius)
-       << ", \"axis_radius_at_max_diameter\": " << num(pk.axis_radius)
-       << ", \"axis_radius_final\": " << num(fin.axis_radius)
-       << ", \"definitions\": \"D_distal: outer crowns of the end rings, D_central: crowns of the middle ring(s); "
-          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = extent of the nodes along the deformed axis (through the ring centroids); "
-          "axis sagitta: distance of the middle crowns' centroid from the chord through the centroids of the end "
-          "rings' outer crowns, axis radius: radius of the circle through the three (null: straight)\"},\n";
+    const double L0 = initial.length;
+    j["stent"] = {
+        {"length_initial", finite(L0)},
+        {"length_at_max_diameter", finite(pk.length)},
+        {"length_final", finite(fin.length)},
+        {"foreshortening_at_max_diameter_percent", finite(100.0 * (L0 - pk.length) / L0)},
+        {"foreshortening_final_percent", finite(100.0 * (L0 - fin.length) / L0)},
+        {"distal_diameter_at_max", finite(pk.distal_diameter)},
+        {"central_diameter_at_max", finite(pk.central_diameter)},
+        {"dogboning_at_max_diameter_percent",
+         finite(100.0 * (pk.distal_diameter - pk.central_diameter) / pk.distal_diameter)},
+        {"dogboning_max_percent", finite(100.0 * dbmax)},
+        {"time_of_dogboning_max", finite(tdb)},
+        {"axis_sagitta_initial", finite(initial.axis_sagitta)},
+        {"axis_sagitta_at_max_diameter", finite(pk.axis_sagitta)},
+        {"axis_sagitta_final", finite(fin.axis_sagitta)},
+        {"axis_radius_initial", finite(initial.axis_radius)},
+        {"axis_radius_at_max_diameter", finite(pk.axis_radius)},
+        {"axis_radius_final", finite(fin.axis_radius)},
+        {"definitions",
+         "D_distal: outer crowns of the end rings, D_central: crowns of the middle ring(s); "
+         "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = extent of the nodes along "
+         "the deformed axis (through the ring centroids); "
+         "axis sagitta: distance of the middle crowns' centroid from the chord through the centroids of the end "
+         "rings' outer crowns, axis radius: radius of the circle through the three (null: straight)"}};
   }
   int total_it = 0;
   double total_wall = 0;
@@ -249,32 +266,39 @@ std::string write_summary(const std::string& path, const BeamModel& m,
     total_it += s.iterations;
     total_wall += s.wall_seconds;
   }
-  os << "  \"newton_iterations_total\": " << total_it << ",\n  \"wall_seconds_total\": " << num(total_wall)
-     << ",\n  \"newton_seconds_total\": " << num(newton_seconds) << ",\n  \"seconds_per_newton_iteration\": "
-     << num(newton_iterations > 0 ? newton_seconds / newton_iterations : 0.0) << ",\n";
-  os << "  \"steps\": [\n";
-  for (size_t i = 0; i < steps.size(); ++i) {
-    const auto& s = steps[i];
-    os << "    {\"step\": " << s.step << ", \"time\": " << num(s.time) << ", \"diameter\": " << num(s.diameter)
-       << ", \"iterations\": " << s.iterations << ", \"residual\": " << num(s.residual)
-       << ", \"max_bending_moment\": " << num(s.max_bending_moment);
-    if (generated_stent)
-      os << ", \"distal_diameter\": " << num(s.distal_diameter) << ", \"central_diameter\": " << num(s.central_diameter)
-         << ", \"length\": " << num(s.length) << ", \"axis_sagitta\": " << num(s.axis_sagitta);
-    os
-       << ", \"wall_seconds\": " << num(s.wall_seconds) << "}" << (i + 1 < steps.size() ? "," : "") << "\n";
+  j["newton_iterations_total"] = total_it;
+  j["wall_seconds_total"] = finite(total_wall);
+  j["newton_seconds_total"] = finite(newton_seconds);
+  j["seconds_per_newton_iteration"] = finite(newton_iterations > 0 ? newton_seconds / newton_iterations : 0.0);
+  j["steps"] = ordered_json::array();
+  for (const auto& s : steps) {
+    ordered_json e;
+    e["step"] = s.step;
+    e["time"] = finite(s.time);
+    e["diameter"] = finite(s.diameter);
+    e["iterations"] = s.iterations;
+    e["residual"] = finite(s.residual);
+    e["max_bending_moment"] = finite(s.max_bending_moment);
+    if (generated_stent) {
+      e["distal_diameter"] = finite(s.distal_diameter);
+      e["central_diameter"] = finite(s.central_diameter);
+      e["length"] = finite(s.length);
+      e["axis_sagitta"] = finite(s.axis_sagitta);
+    }
+    e["wall_seconds"] = finite(s.wall_seconds);
+    j["steps"].push_back(std::move(e));
   }
-  os << "  ],\n  \"final_positions\": [\n";
+  j["final_positions"] = ordered_json::array();
   for (int n = 0; n < m.num_nodes(); ++n) {
     const Vec3& x = m.position(n);
-    os << "    [" << num(x.x()) << ", " << num(x.y()) << ", " << num(x.z()) << "]"
-       << (n + 1 < m.num_nodes() ? "," : "") << "\n";
+    j["final_positions"].push_back({finite(x.x()), finite(x.y()), finite(x.z())});
   }
-  os << "  ]\n}\n";
+  // invalid UTF-8 in a string (a status or path from outside) is replaced, not an exception
+  const std::string text = j.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n";
   std::ofstream f(path);
   if (!f) throw std::runtime_error("cannot write " + path);
-  f << os.str();
-  return os.str();
+  f << text;
+  return text;
 }
 
 }  // namespace angio::beam

@@ -1,10 +1,10 @@
 // coupler: owns the load steps and the coupling iteration of a run (Dirichlet–Neumann or robin,
 // coupling_loop.hpp); talks to beam_solver and solid_solver over zenoh and never touches element
 // data (DESIGN §2).
+#include <algorithm>
 #include <chrono>
-#include <functional>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <iomanip>
 #include <memory>
 #include <optional>
@@ -13,6 +13,7 @@
 #include "angio/common/log.hpp"
 #include "angio/coupler/coupling_loop.hpp"
 #include "angio/coupler/step_csv.hpp"
+#include "angio/coupler/summary.hpp"
 #include "angio/participant/keys.hpp"
 #include "angio/participant/remote.hpp"
 #include "angio/recording/recording.hpp"
@@ -24,33 +25,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// coupling_summary.json (summary.hpp); a summary that cannot be written is logged, not thrown, so
+// that a failed run still ends with its own error and exit code
 void write_summary(const fs::path& path, const std::string& status, const std::string& error,
                    const coupler::RunReport& run, double messaging) {
-  std::ofstream o(path);
-  o << std::setprecision(10) << "{\n"
-    << "  \"status\": \"" << status << "\",\n"
-    << "  \"error\": \"" << error << "\",\n"  // already JSON-escaped by the caller
-    << "  \"steps\": " << run.steps << ",\n"
-    << "  \"rejected_attempts\": " << run.rejected_attempts << ",\n"
-    << "  \"coupling_iterations_total\": " << run.total_iterations << ",\n"
-    << "  \"coupling_iterations_mean\": "
-    << run.mean_iterations() << ",\n"
-    << "  \"coupling_iterations_max\": " << run.max_iterations << ",\n"
-    << "  \"wall_time\": " << run.wall_time << ",\n"
-    << "  \"beam_time\": " << run.beam_time << ",\n"
-    << "  \"solid_time\": " << run.solid_time << ",\n"
-    << "  \"messaging_time\": " << messaging << ",\n"
-    << "  \"messaging_share\": " << (run.wall_time > 0 ? messaging / run.wall_time : 0.0) << "\n"
-    << "}\n";
-}
-
-std::string json_escape(std::string s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += (c == '\n') ? ' ' : c;
-  }
-  return out;
+  if (!coupler::write_coupling_summary(path.string(), status, error, run, messaging))
+    LOG_ERROR("cannot write " << path.string());
 }
 
 int run(const cli::Parser& args) {
@@ -105,7 +85,7 @@ int run(const cli::Parser& args) {
     });
   } catch (const std::exception& e) {
     LOG_ERROR(e.what());
-    write_summary(run_dir / "coupling_summary.json", "failed", json_escape(e.what()), report,
+    write_summary(run_dir / "coupling_summary.json", "failed", e.what(), report,
                   beam_ch.messaging_time() + solid_ch.messaging_time());
     // Tell the participants to finish so they close their output cleanly; their own errors are
     // secondary to the one reported above.

@@ -53,8 +53,9 @@ struct StepRecord {
   double axis_radius = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Writes summary.json; returns the text written. `initial`: the measures of the reference state
-// (its diameter for every model, the stent measures for generated stents).
+// Writes summary.json (nlohmann::json, indent 2; non-finite numbers as null); returns the text
+// written. `initial`: the measures of the reference state (its diameter for every model, the
+// stent measures for generated stents).
 std::string write_summary(const std::string& path, const BeamModel& m,
                           const std::vector<StepRecord>& steps, bool generated_stent,
                           const std::string& status, double newton_seconds, long newton_iterations,
