@@ -216,3 +216,22 @@ TEST(Messages, StepStateAcceptsTheProtocolOrderOnly) {
   EXPECT_FALSE(s.in_step());
   ok(s, msg::shutdown(coupler(++n), "done"));
 }
+
+// A request is answered only under its own verb (angio/<run>/<role>/<verb>): a foreign peer querying
+// another verb, or a reply sent as a request, is refused.
+TEST(Messages, RequestsTravelUnderTheirOwnVerb) {
+  std::uint64_t n = 0;
+  const auto hello = msg::hello(coupler(++n), "test");
+  const auto end = msg::step_end(coupler(++n), 1, true);
+  EXPECT_NO_THROW(msg::check_verb(msg::open(hello, "run-A"), "angio/run-A/solid/hello"));
+  EXPECT_NO_THROW(msg::check_verb(msg::open(end, "run-A"), "angio/run-A/beam/step_end"));
+  try {
+    msg::check_verb(msg::open(hello, "run-A"), "angio/run-A/solid/solve");
+    ADD_FAILURE() << "a Hello under 'solve' accepted";
+  } catch (const ProtocolError& e) {
+    EXPECT_NE(std::string(e.what()).find("under the verb 'solve' (expected 'hello')"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(msg::check_verb(msg::open(msg::ack(coupler(++n)), "run-A"), "angio/run-A/solid/ack"), ProtocolError);
+  EXPECT_STREQ(msg::request_verb(fb::Payload::SolidSolveRequest), "solve");
+  EXPECT_EQ(msg::request_verb(fb::Payload::Error), nullptr);
+}

@@ -17,6 +17,29 @@ const char* payload_name(fb::Payload p) {
   return (n && *n) ? n : "unknown payload";
 }
 
+const char* request_verb(fb::Payload p) {
+  switch (p) {
+    case fb::Payload::Hello: return "hello";
+    case fb::Payload::StepBegin: return "step_begin";
+    case fb::Payload::BeamSolveRequest:
+    case fb::Payload::SolidSolveRequest: return "solve";
+    case fb::Payload::StepEnd: return "step_end";
+    case fb::Payload::Shutdown: return "shutdown";
+    default: return nullptr;
+  }
+}
+
+void check_verb(const fb::Envelope& env, std::string_view key) {
+  const auto slash = key.rfind('/');
+  const std::string_view verb = slash == std::string_view::npos ? key : key.substr(slash + 1);
+  const char* expected = request_verb(env.payload_type());
+  if (!expected)
+    throw ProtocolError(std::string("a ") + payload_name(env.payload_type()) + " is not a request");
+  if (verb != expected)
+    throw ProtocolError("a " + std::string(payload_name(env.payload_type())) + " request under the verb '" +
+                        std::string(verb) + "' (expected '" + expected + "')");
+}
+
 const fb::Envelope& open(std::span<const std::uint8_t> bytes, const std::string& run_id) {
   if (bytes.size() < 8)
     throw ProtocolError("message of " + std::to_string(bytes.size()) +

@@ -29,6 +29,9 @@ bool Channel::alive(std::chrono::milliseconds timeout) const {
 msg::Buffer Channel::call(const std::string& verb, const Build& build) {
   const std::uint64_t seq = sequence_.next();
   msg::Buffer request = build(msg::Header{run_id_, seq, fb::Role::Coupler});
+  // the participant checks the verb of the key against the payload (msg::check_verb): one table
+  if (const char* v = msg::request_verb(fb::GetEnvelope(request.data())->payload_type()); !v || verb != v)
+    throw std::logic_error("Channel::call: verb '" + verb + "' does not match the request built");
   const auto t0 = Clock::now();
   msg::Buffer reply;
   try {

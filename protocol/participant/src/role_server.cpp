@@ -67,6 +67,7 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
     try {
       const fb::Envelope& env = msg::open(q->payload(), o.run_id);
       h.sequence = env.sequence();
+      msg::check_verb(env, q->key());
       sequence.check_request(env);
       state.check(env);
       q->reply(dispatch(env, h, stop));

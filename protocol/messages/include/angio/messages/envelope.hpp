@@ -8,6 +8,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "angio/fb/angio_generated.h"
@@ -27,6 +28,13 @@ using Buffer = std::vector<std::uint8_t>;
 const char* role_name(fb::Role r);  // "Coupler", "Beam", "Solid"
 const char* role_key(fb::Role r);   // "coupler", "beam", "solid": the role in key expressions
 const char* payload_name(fb::Payload p);
+
+// The verb a request travels under (the last chunk of its key angio/<run>/<role>/<verb>): "hello",
+// "step_begin", "solve", "step_end", "shutdown"; nullptr for payloads that are not requests.
+const char* request_verb(fb::Payload p);
+// Throws ProtocolError unless `key` ends in the verb of the envelope's payload: a request must not
+// be answered under another verb (a foreign peer probing angio/<run>/<role>/anything).
+void check_verb(const fb::Envelope& env, std::string_view key);
 
 // Verifies `bytes` and returns the envelope inside (pointing into `bytes`). Throws ProtocolError
 // for a truncated/corrupt buffer, a wrong file identifier, another protocol version or a foreign
