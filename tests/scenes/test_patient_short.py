@@ -23,7 +23,6 @@ import yaml
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 from patient.centerline_csv import write_centerline_csv  # noqa: E402
-from patient.placement import nearest_on_polyline  # noqa: E402
 
 failures = []
 
