@@ -20,17 +20,12 @@ import h5py
 import numpy as np
 import yaml
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checklist import check, finish  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
 from patient.centerline_csv import write_centerline_csv  # noqa: E402
-
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
 
 
 def tiny_centerline(n=41, length=8.0, bend=12.0):
@@ -132,5 +127,4 @@ with tempfile.TemporaryDirectory(prefix="patient-short-") as tmp:
         check("Traceback" not in p.stderr, f"{name}: no traceback")
         check(not (Path(tmp) / "run-bad").exists(), f"{name}: no run directory left behind")
 
-print("FAILED: " + "; ".join(failures) if failures else "all passed")
-sys.exit(1 if failures else 0)
+finish()

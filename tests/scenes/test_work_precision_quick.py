@@ -14,14 +14,10 @@ from pathlib import Path
 
 import yaml
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checklist import check, finish  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
-failures = []
-
-
-def check(cond, msg):
-    print(("ok   " if cond else "FAIL ") + msg)
-    if not cond:
-        failures.append(msg)
 
 
 bin_dir = Path(sys.argv[1]).resolve()
@@ -51,5 +47,4 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
     check(e[0] >= e[1], f"tighter coupling tolerance, smaller diameter error ({e[0]:.2e} >= {e[1]:.2e})")
     check("verdict" in r.stdout, "a verdict is printed")
 
-print("FAILED: " + "; ".join(failures) if failures else "all passed")
-sys.exit(1 if failures else 0)
+finish()
