@@ -71,8 +71,11 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
     // η·V_a per dof: each owned element adds η·V_e/n_e to its nodes (a lumped "mass" of unit density)
     ANGIO_PETSC(VecDuplicate(r_, &damping_diag_));
     ANGIO_PETSC(VecSet(damping_diag_, 0.0));
+    const auto& parts = opt_.newton.damping_parts;
     for (int e : local_elements_) {
       const auto& el = mesh_.elements[e];
+      if (!parts.empty() && std::find(parts.begin(), parts.end(), mesh_.blocks[el.block].part) == parts.end())
+        continue;
       const double m = opt_.newton.damping * volume[e] / el.nn();
       for (int a = 0; a < el.nn(); ++a)
         for (int k = 0; k < 3; ++k) ANGIO_PETSC(VecSetValue(damping_diag_, 3 * perm_[el.n[a]] + k, m, ADD_VALUES));

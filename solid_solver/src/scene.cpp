@@ -372,7 +372,7 @@ SolidScene read_solid_scene(const Node& root) {
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
       n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
-                     "reuse_preconditioner", "tangent", "max_contraction"});
+                     "damping_parts", "reuse_preconditioner", "tangent", "max_contraction"});
       auto& no = sc.options.newton;
       no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
       no.rtol = n->positive_or("rtol", no.rtol);
@@ -381,6 +381,17 @@ SolidScene read_solid_scene(const Node& root) {
       no.max_line_search = int(n->integer_or("max_line_search", no.max_line_search, 0));
       no.verbose = n->boolean_or("verbose", no.verbose);
       no.damping = n->non_negative_or("damping", no.damping);
+      if (auto dp = n->optional("damping_parts")) {
+        if (!(no.damping > 0)) dp->fail("no damping_parts without damping > 0");
+        if (!dp->is_sequence() || dp->size() == 0) dp->fail("a list of parts out of balloon, artery");
+        for (size_t i = 0; i < dp->size(); ++i) {
+          const std::string part = dp->at(i).as_string();
+          if (!((part == "balloon" && sc.has_balloon) || (part == "artery" && sc.has_artery)))
+            dp->at(i).fail(std::string("a part of this scene (") + (sc.has_balloon ? "balloon" : "") +
+                           (sc.has_balloon && sc.has_artery ? ", " : "") + (sc.has_artery ? "artery" : "") + ")");
+          no.damping_parts.push_back(part);
+        }
+      }
       const long lag = n->integer_or("reuse_preconditioner", no.reuse_preconditioner, 0);
       if (lag > 1000) n->child("reuse_preconditioner").fail("at most 1000 Krylov iterations per reused preconditioner");
       no.reuse_preconditioner = int(lag);

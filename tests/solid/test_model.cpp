@@ -199,6 +199,38 @@ TEST(Model, DampingConvergesToTheEquilibrium) {
   EXPECT_EQ(f0[0], 0.0);   // off by default
 }
 
+// newton.damping_parts, consistency: damping restricted to a part the mesh does not have gives the
+// undamped solution exactly (no damping force), restricted to the mesh's own part the globally
+// damped one.
+TEST(Model, DampingPartsSelectTheDampedElements) {
+  const double p = 0.05;
+  auto solve = [&](double eta, std::vector<std::string> parts, double& force) {
+    const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);  // one block, part "test"
+    ModelOptions o = direct_options();
+    o.newton.damping = eta;
+    o.newton.damping_parts = std::move(parts);
+    auto model = pressed_cube(m, LayerMaterial{"cube", {2.0, 0.3}, {}}, o, p);
+    model->start_at(0.0);
+    model->set_time(1.0);
+    const auto rep = model->solve();
+    EXPECT_TRUE(rep.converged) << rep.message;
+    force = rep.damping_force;
+    return displacements(*model);
+  };
+  double f_none = -1, f_all = -1, f_other = -1, f_own = -1;
+  const auto u_none = solve(0.0, {}, f_none);
+  const auto u_all = solve(0.5, {}, f_all);
+  const auto u_other = solve(0.5, {"balloon"}, f_other);
+  const auto u_own = solve(0.5, {"test"}, f_own);
+  double scale = 0;
+  for (const auto& v : u_none) scale = std::max(scale, v.norm());
+  EXPECT_GT(max_diff(u_all, u_none), 0.05 * scale);  // the damping acts
+  EXPECT_EQ(f_other, 0.0);
+  EXPECT_LT(max_diff(u_other, u_none), 1e-12 * scale);
+  EXPECT_GT(f_own, 0.0);
+  EXPECT_LT(max_diff(u_own, u_all), 1e-12 * scale);
+}
+
 // Lagged preconditioner (newton.reuse_preconditioner), consistency: GMRES preconditioned with the
 // LU factorization of an earlier tangent converges to the same solution as a fresh LU at every Newton
 // iteration (same load steps, fibers in tension), with fewer factorizations than Newton iterations,

@@ -47,6 +47,9 @@ struct NewtonOptions {
   // strongly per unit rate and its tangent term η·V_a/Δt grows, where a spring toward the committed
   // state would weaken with the shorter increment. 0 = off.
   double damping = 0.0;
+  // The parts (Block::part, e.g. "balloon") whose elements get the damping; empty: every element. A
+  // balloon's unfolding needs it, an artery must not carry its blood pressure by viscosity.
+  std::vector<std::string> damping_parts;
   // Lagged preconditioner: > 0 keeps the preconditioner (e.g. the LU factorization of -pc_type lu)
   // of an earlier tangent for later Newton iterations and later solves (coupling iterations, steps)
   // while the Krylov solver (e.g. GMRES) needs at most this many iterations with it; past that, or
