@@ -331,7 +331,7 @@ void BeamModel::assemble_global(SpMat* K, Eigen::VectorXd& rg) {
   for (int e = 0; e < ne; ++e) {
     const auto [a, b] = elem_nodes_[e];
     elem_results_[e] = evaluate_element(sections_[elem_section_[e]], eref_[e], x_[a], x_[b], R_[a], R_[b],
-                                        mp_committed_[e], K != nullptr);
+                                        mp_committed_[e], K != nullptr, residual_form);
   }
   for (int e = 0; e < ne; ++e) {
     const auto [a, b] = elem_nodes_[e];

@@ -25,6 +25,7 @@ BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string&
   LOG_INFO("beam model: " << m.num_nodes() << " nodes, " << m.num_elements() << " elements, "
                           << m.num_free_dofs() << " free DOFs, " << m.num_sample_points()
                           << " contact sample points, linear solver " << m.newton.linear_solver
+                          << (m.residual_form == ResidualForm::petrov_galerkin ? ", Petrov-Galerkin residual" : "")
                           << (scene_.generated_stent ? ", generated stent, diameter " : ", diameter ")
                           << m.diameter() << " mm");
 }

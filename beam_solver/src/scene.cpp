@@ -131,10 +131,18 @@ BeamScene beam_scene_from(const Node& root) {
   const scene::LoadCurves curves = scene::load_curves(root);
   const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
   st.check_keys({"material", "plasticity", "section", "generator", "nodes", "elements", "lines",
-                 "up", "axis", "fixation", "supports", "loads", "solver", "contact", "triads"});
+                 "up", "axis", "fixation", "supports", "loads", "solver", "contact", "triads",
+                 "element"});
   bs.model = std::make_unique<BeamModel>();
   BeamModel& m = *bs.model;
   const int sec = m.add_section(read_section(st));
+
+  // element: {residual: consistent | petrov_galerkin} (element.hpp, ResidualForm)
+  if (auto el = st.optional("element")) {
+    el->check_keys({"residual"});
+    if (el->choice_or("residual", {"consistent", "petrov_galerkin"}, "consistent") == "petrov_galerkin")
+      m.residual_form = ResidualForm::petrov_galerkin;
+  }
 
   if (auto c = st.optional("contact")) {
     c->check_keys({"points_per_element"});

@@ -9,6 +9,9 @@
 // The tangent is the exact linearization of the residual with respect to the spatial
 // multiplicative rotation increments (Λ ← exp(Δθ) Λ) and the displacement increments, obtained
 // with nested forward-mode automatic differentiation (dual.hpp).
+// Two variational forms share the strains and the section law (ResidualForm): the consistent
+// variation of the strain energy (default) and 4C's Petrov–Galerkin form (beam3r, Jelenić &
+// Crisfield 1999), which tests the rotational equations with the Lagrange shape functions.
 // DOF order: [x1 (3), θ1 (3), x2 (3), θ2 (3)].
 #pragma once
 
@@ -45,9 +48,25 @@ struct ElementResult {
   SectionResponse section;
 };
 
+// Variational form of the element residual (scene key stent.element.residual).
+//  consistent       r = L Bᵀ(F, M), B = ∂(Γ, Ω)/∂(δx, δθ): Bubnov–Galerkin, the exact variation
+//                   of the strain energy; the rotational test functions are Jelenić–Crisfield's
+//                   generalized shape functions Ĩ (δθ_r and δφ = J⁻¹(φ)Λ1ᵀ(δθ2 − δθ1)).
+//  petrov_galerkin  4C beam3r (Jelenić & Crisfield 1999: weak form tested with the Lagrange
+//                   functions I_a for δx and δθ): with n = Λ_r F, m = Λ_r M, d = x2 − x1 at the
+//                   single (midpoint) Gauss point, where I_a = ½ and I_a' = ∓1/L,
+//                     r_x1 = −n, r_θ1 = −m − ½ d×n,  r_x2 = n, r_θ2 = m − ½ d×n.
+//                   Non-symmetric tangent even at equilibrium (needs an LU solver; all of
+//                   linear_solver.hpp's backends are LU). Equal to the consistent form when
+//                   M ∥ φ and d×n ∥ Λ_r φ (e.g. planar bending, or elastic GJ = EI without
+//                   shear); otherwise the rotational residuals differ by O(φ) relative in the
+//                   d×n term and O(φ²) in the moment term (φ: relative rotation of the element).
+enum class ResidualForm { consistent, petrov_galerkin };
+
 ElementResult evaluate_element(const Section& s, const ElementReference& ref, const Vec3& x1,
                                const Vec3& x2, const Quat& R1, const Quat& R2,
-                               const PlasticState& committed, bool with_tangent = true);
+                               const PlasticState& committed, bool with_tangent = true,
+                               ResidualForm form = ResidualForm::consistent);
 
 // Rotation helpers.
 Quat quat_exp(const Vec3& theta);   // exp of a rotation vector

@@ -113,6 +113,9 @@ class BeamModel {
   std::vector<PrescribedDisplacement> prescribed_displacements;
   std::vector<PrescribedRotation> prescribed_rotations;
   NewtonOptions newton;
+  // Variational form of the element residuals (element.hpp); petrov_galerkin gives a
+  // non-symmetric tangent, which every backend of linear_solver.hpp (LU) handles.
+  ResidualForm residual_form = ResidualForm::consistent;
   int sample_points_per_element = 6;
 
   void finalize();  // builds the DOF map; required before solving
