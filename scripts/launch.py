@@ -480,8 +480,21 @@ def main():
     procs = []
     interrupted = {"sig": None}
 
+    coupler_proc = lambda: next((pr for pr in procs if pr.name == "coupler"), None)  # noqa: E731
+
     def forward(sig, _frame):
+        # A first Ctrl-C in a coupled run goes to the coupler alone: it finishes the step under way and
+        # shuts the participants down, so every summary is written (mpirun would kill the solid's ranks
+        # on a SIGINT of its own). A second Ctrl-C, or SIGTERM, stops everything now.
+        c = coupler_proc()
+        if sig == signal.SIGINT and interrupted["sig"] is None and c is not None and c.p.poll() is None:
+            interrupted["sig"] = sig
+            interrupted["graceful"] = True
+            print("launch: stopping after the current step (Ctrl-C again to stop now)", file=sys.stderr, flush=True)
+            c.signal(signal.SIGINT)
+            return
         interrupted["sig"] = sig
+        interrupted["graceful"] = False
         for pr in procs:
             pr.signal(signal.SIGINT if sig == signal.SIGINT else signal.SIGTERM)
 
@@ -505,7 +518,7 @@ def main():
                 failed = (pr.name, rc)
         if failed or not alive:
             break
-        if interrupted["sig"] is not None:
+        if interrupted["sig"] is not None and not interrupted.get("graceful"):
             stop_all(procs, grace=10.0)
             break
         time.sleep(0.2)

@@ -145,7 +145,14 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     run.steps++;
     run.total_iterations += rep.iterations;
     run.max_iterations = std::max(run.max_iterations, rep.iterations);
-    if (on_step) on_step(rep);
+    if (on_step) {
+      try {
+        on_step(rep);
+      } catch (const StopRequested&) {
+        run.interrupted = true;
+        break;
+      }
+    }
     stepper.accept(rep.iterations);
     step_start = Clock::now();
   }

@@ -3,6 +3,7 @@
 // data (DESIGN §2).
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
@@ -24,6 +25,13 @@ using namespace angio;
 namespace fs = std::filesystem;
 
 namespace {
+// Ctrl-C (SIGINT, forwarded by the launcher): finish the step under way, then stop cleanly (the
+// participants are shut down and write their summaries). A second signal or SIGTERM stops at once.
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_sigint(int) {
+  if (g_stop) std::_Exit(130);
+  g_stop = 1;
+}
 
 // coupling_summary.json (summary.hpp); a summary that cannot be written is logged, not thrown, so
 // that a failed run still ends with its own error and exit code
@@ -46,6 +54,7 @@ int run(const cli::Parser& args) {
   fs::create_directories(run_dir);
   const std::string run_id = args.get("run-id");
   const auto timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
+  std::signal(SIGINT, on_sigint);
 
   std::unique_ptr<recording::Recorder> recorder;
   if (settings.record || args.has("record"))
@@ -82,6 +91,7 @@ int run(const cli::Parser& args) {
                        << ", " << r.contact.n_active << " active, wall " << std::setprecision(3)
                        << r.wall_time << " s (beam " << r.beam_time << ", solid " << r.solid_time
                        << ")");
+      if (g_stop) throw coupler::StopRequested{};
     });
   } catch (const std::exception& e) {
     LOG_ERROR(e.what());
@@ -107,6 +117,13 @@ int run(const cli::Parser& args) {
   beam.finish();
   solid.finish();
   const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
+  if (report.interrupted) {
+    const std::string why = "interrupted (SIGINT) after step " + std::to_string(report.steps) +
+                            "; the participants were shut down and wrote their results so far";
+    LOG_WARN(why);
+    write_summary(run_dir / "coupling_summary.json", "interrupted", why, report, messaging);
+    return 130;
+  }
   write_summary(run_dir / "coupling_summary.json", "ok", "", report, messaging);
   LOG_INFO("done: " << report.steps << " steps, coupling iterations mean "
                     << report.mean_iterations()

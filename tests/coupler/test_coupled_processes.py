@@ -5,7 +5,8 @@
    force equals the analytic coupled solution (spring_participants.hpp), a recording is written.
 2. coupler + two replay participants answering from that recording reproduce the recorded
    iteration history exactly (same iterations, residuals and relaxation factors per step).
-3. a participant that dies makes the launcher stop everything and name it (non-zero exit).
+3. a participant that dies makes the launcher stop everything and name it (non-zero exit); Ctrl-C
+   stops after the step under way, with the participants shut down and the summary "interrupted".
 4. a coupler without participants fails with a timeout error instead of hanging.
 5. a frozen participant (SIGSTOP) stops the run within --timeout + a few seconds, the coupler names
    it, the launcher passes the coupler's diagnosis on, the summary says failed, nothing is left.
@@ -93,6 +94,12 @@ with tempfile.TemporaryDirectory() as tmp:
         check(False, "interrupted launcher ends within 30 s")
     left = subprocess.run(["pgrep", "-f", "interrupt-me"], capture_output=True, text=True).stdout.split()
     check(not left, f"no process of the interrupted run is left ({left})")
+    # the first Ctrl-C stops after the step under way: the committed steps and the summary agree
+    summ = json.loads((tmp / "interrupted" / "coupling_summary.json").read_text())
+    n_rows = len(rows(tmp / "interrupted"))
+    check(summ.get("status") == "interrupted" and summ.get("steps") == n_rows and n_rows >= 1,
+          f"interrupted run: summary status {summ.get('status')}, {summ.get('steps')} steps, "
+          f"{n_rows} rows in coupling.csv")
 
     # 4. no participants: the coupler times out with a clear error
     t0 = time.time()

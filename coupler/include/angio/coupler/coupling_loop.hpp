@@ -42,7 +42,13 @@ struct RunReport {
   // s in solves over every attempt, rejected steps included
   double beam_time = 0.0;
   double solid_time = 0.0;
+  bool interrupted = false;  // stopped after a committed step at the callback's request (StopRequested)
 };
+
+// Thrown by a StepCallback to stop the run after the step it was called for (committed): run_coupled
+// returns its report with `interrupted` set instead of going on (e.g. Ctrl-C: everything written so
+// far stays consistent, and the participants can still be shut down normally).
+struct StopRequested {};
 
 using StepCallback = std::function<void(const StepReport&)>;
 
