@@ -164,6 +164,32 @@ def prepare_patient(scene, scene_path):
     return scratch, done
 
 
+def scratch_scene(prepared):
+    """The completed patient scene written into its scratch directory (for --check)."""
+    scratch, done = prepared
+    path = scratch / "scene.yaml"
+    with open(path, "w") as f:
+        yaml.safe_dump(done, f, sort_keys=False)
+    return path
+
+
+def check_scene_with(name, exe, scene_path):
+    """Runs `exe --scene S --check`: exit 2 with the executable's own message (file, key) if the
+    scene is bad."""
+    try:
+        r = subprocess.run(exe + ["--scene", str(scene_path), "--check", "--log-level", "error"],
+                           capture_output=True, text=True, errors="replace", timeout=600)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        die(f"cannot check the scene with {name}: {e}", code=1)
+    if r.returncode == 0:
+        return
+    msg = next((ln for ln in reversed((r.stderr + r.stdout).splitlines()) if ln.strip()), "")
+    msg = re.sub(r"^\[[a-z_]+\] (ERROR: )?", "", msg.strip())
+    if r.returncode == 2:
+        die(msg or f"{name} refused the scene")
+    die(f"{name} --check failed with exit code {r.returncode}: {msg}", code=1)
+
+
 def install_prepared(prepared, run_dir):
     """Moves the generated geometry to <run_dir>/geometry and writes the completed scene with its
     paths there; returns the completed scene's path."""
@@ -171,6 +197,7 @@ def install_prepared(prepared, run_dir):
     dest = run_dir / "geometry"
     if dest.exists():  # a reused --run-dir: the geometry of this launch replaces the last one's
         shutil.rmtree(dest)
+    (scratch / "scene.yaml").unlink(missing_ok=True)  # the checked copy, with the scratch paths
     shutil.move(str(scratch), str(dest))
 
     def relocate(node):
@@ -442,6 +469,17 @@ def main():
         solid_exe = command_arg("--solid-cmd", args.solid_cmd) if args.solid_cmd else mpirun + [find_binary(build, "solid_solver")]
     if has_stent and has_solid:
         coupler_exe = [find_binary(build, "coupler")]
+
+    # Each executable reads the keys of its sections; asking them (--check) before the run directory
+    # exists means a bad key anywhere leaves nothing behind. Replaced commands (--beam-cmd,
+    # --solid-cmd) may not know --check and are not asked.
+    check_path = scene_path if prepared is None else scratch_scene(prepared)
+    checks = [("beam_solver", beam_exe if has_stent and not args.beam_cmd else None),
+              ("solid_solver", [find_binary(build, "solid_solver")] if has_solid and not args.solid_cmd else None),
+              ("coupler", coupler_exe)]
+    for name, exe in checks:
+        if exe:
+            check_scene_with(name, exe, check_path)
 
     token = uuid.uuid4().hex[:12]
     run_id = args.run_id or token

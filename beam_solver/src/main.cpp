@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
     angio::cli::setup_logging(cli, "beam");
     angio::cli::require(cli, {"scene"});
     angio::beam::BeamScene scene = angio::beam::load_beam_scene(cli.get("scene"));
+    if (cli.has("check")) return 0;  // the scene and the stent it generates are valid
     const std::string run_dir = cli.get("run-dir");
     std::filesystem::create_directories(run_dir);
     const auto time = scene.time;

@@ -50,6 +50,7 @@ int run(const cli::Parser& args) {
   scene::ScaledCurve balloon_pressure;
   if (const auto b = root.optional("balloon"); b && b->has("pressure"))
     balloon_pressure = scene::scaled_curve(*b, "pressure", curves);
+  if (args.has("check")) return 0;  // time, load curves and coupling settings are valid
   const fs::path run_dir = args.get("run-dir");
   fs::create_directories(run_dir);
   const std::string run_id = args.get("run-id");
@@ -144,7 +145,8 @@ int main(int argc, char** argv) {
   args.add({"record", "", "record every exchanged message into <run-dir>/exchanges.angiorec", ""});
   return cli::run_main(args, argc, argv, [&] {
     cli::setup_logging(args, "coupler");
-    cli::require(args, {"scene", "endpoint"});
+    if (args.has("check")) cli::require(args, {"scene"});
+    else cli::require(args, {"scene", "endpoint"});
     return run(args);
   });
 }

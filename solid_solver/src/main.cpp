@@ -62,6 +62,10 @@ int main(int argc, char** argv) {
       PetscFinalize();
       return 2;
     }
+    if (cli.has("check")) {  // the scene is valid and its mesh was built (no run directory)
+      PetscFinalize();
+      return 0;
+    }
     try {
       angio::solid::SolidRunner runner(PETSC_COMM_WORLD, std::move(scene), cli.get("run-dir"));
       angio::solid::ContactSetup contact(runner, contact_spec);

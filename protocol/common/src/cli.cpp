@@ -25,6 +25,7 @@ Parser& Parser::add_common() {
        "run"});
   add({"timeout", "SECONDS", "give up when the peer is silent or gone this long", "600"});
   add({"log-level", "LEVEL", "debug, info, warn or error", "info"});
+  add({"check", "", "read and check the scene (and build the model), then exit: 0 valid, 2 the error", ""});
   return *this;
 }
 

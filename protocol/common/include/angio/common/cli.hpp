@@ -1,5 +1,5 @@
 // Command-line options shared by the three executables, so every process answers to the same
-// flags: --scene FILE, --run-dir DIR, --endpoint E, --run-id ID, --timeout S, --log-level L.
+// flags: --scene FILE, --run-dir DIR, --endpoint E, --run-id ID, --timeout S, --log-level L, --check.
 #pragma once
 
 #include <functional>
