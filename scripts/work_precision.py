@@ -227,7 +227,10 @@ def plot(knob_runs, path):
             for w, e, shipped in pts:
                 if shipped:
                     ax.loglog([w], [e], "*", color=f"C{i}", markersize=12)
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())  # a narrow time range: no clutter
+        # wall times often span less than a decade: label 1-2-5 ticks instead of the decades only
+        ax.xaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_title(name, fontsize=9)
         ax.set_xlabel("wall time (s)")
         ax.set_ylabel("relative error")
@@ -253,7 +256,8 @@ def main():
     if not (a.tol > 0 and math.isfinite(a.tol)):
         print(f"work_precision: --tol: expected a positive number, got {a.tol}", file=sys.stderr)
         return 2
-    base_path = os.path.abspath(a.scene if os.path.isfile(a.scene) else os.path.join(ROOT, "configs", a.scene))
+    cands = [a.scene, os.path.join(ROOT, "configs", a.scene), os.path.join(ROOT, "configs", a.scene + ".yaml")]
+    base_path = os.path.abspath(next((c for c in cands if os.path.isfile(c)), a.scene))
     if not os.path.isfile(base_path):
         print(f"work_precision: {a.scene}: no such scene", file=sys.stderr)
         return 2
@@ -310,6 +314,12 @@ def main():
     print(f"verdict: at the shipped settings the largest error comes from '{dom}'"
           f" ({max(verdict['shipped_errors'].get(dom, {}).values(), default=0):.2e})" if dom else
           "verdict: no knob changes the outputs measurably at the shipped settings")
+    for k, kr in knob_runs.items():
+        ok = [r for r in kr["runs"] if r["status"] == "ok"]
+        if ok and all(not is_finer(k, r["level"], next(x["level"] for x in ok if x["shipped"])) for r in ok
+                      if any(x["shipped"] for x in ok)):
+            print(f"  {k}: the shipped setting is the finest of this ladder, its own error is not estimated "
+                  f"(the full ladder, without --quick, has finer levels)")
     for k, c in verdict["cheapest_within_tol"].items():
         print(f"  cheapest {k} keeping every output within {100 * a.tol:g} %: {c['level']} ({c['wall_s']:.1f} s)")
     for k, o in verdict["orders"].items():
