@@ -155,12 +155,8 @@ def prepare_patient(scene, scene_path):
     atexit.register(shutil.rmtree, scratch, True)  # left over only if the launch stops before the move
     try:
         done, _ = prepare_scene(scene, scene_path, scratch, log=lambda m: print(f"launch: {m}", flush=True))
-    except PatientInputError as e:
-        shutil.rmtree(scratch, ignore_errors=True)
+    except PatientInputError as e:  # bad input, including a geometry gmsh cannot mesh (the atexit removes scratch)
         die(str(e))
-    except Exception as e:  # gmsh (a bare Exception) or the layer split: a geometry it cannot mesh
-        shutil.rmtree(scratch, ignore_errors=True)
-        die(f"{scene_path}: patient: cannot mesh the artery from this centerline: {' '.join(str(e).split())}")
     return scratch, done
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .centerline_csv import arc_length
 from .errors import PatientInputError
 
 LAYERS = ("intima", "media", "adventitia")
@@ -52,7 +53,7 @@ def rotation_minimizing_normals(pts):
 
 def resample(points, values, spacing):
     """Stations at (about) equal arc-length spacing, values interpolated linearly."""
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    s = arc_length(points)
     n = max(int(math.ceil(s[-1] / spacing)), 3) + 1
     si = np.linspace(0.0, s[-1], n)
     P = np.column_stack([np.interp(si, s, points[:, c]) for c in range(3)])
@@ -75,7 +76,7 @@ def layer_radii(r, wall, spec, where):
 
 
 def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, loft_spacing=0.5,
-                 lumen_size=None, where="patient", log=print):
+                 where="patient", log=print):
     """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts."""
     import gmsh
 
@@ -144,22 +145,6 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
             if not tags:
                 raise RuntimeError(f"no faces found for the surface '{name}'")
             gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
-        # the lumen is what the stent and balloon touch: optionally finer there (lumen_size), growing
-        # to mesh_size through the wall. Curved tet10 faces follow the circular lumen to O(h^3), so
-        # the default is one size.
-        h_lumen = min(mesh_size, lumen_size) if lumen_size else mesh_size
-        if h_lumen < mesh_size:
-            f_dist = gmsh.model.mesh.field.add("Distance")
-            gmsh.model.mesh.field.setNumbers(f_dist, "FacesList", endo)
-            f_thr = gmsh.model.mesh.field.add("Threshold")
-            gmsh.model.mesh.field.setNumber(f_thr, "InField", f_dist)
-            gmsh.model.mesh.field.setNumber(f_thr, "SizeMin", h_lumen)
-            gmsh.model.mesh.field.setNumber(f_thr, "SizeMax", mesh_size)
-            gmsh.model.mesh.field.setNumber(f_thr, "DistMin", 0.0)
-            gmsh.model.mesh.field.setNumber(f_thr, "DistMax", float(w.max()))
-            gmsh.model.mesh.field.setAsBackgroundMesh(f_thr)
-            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
         gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * mesh_size)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
@@ -193,11 +178,19 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
                      for name in LAYERS}
         return {"file": str(out_path), "elements": int(n_tets), "nodes": int(len(node_tags)),
                 "dofs": 3 * int(len(node_tags)), "per_layer": per_layer, "mesh_size": mesh_size,
-                "lumen_size": h_lumen, "straightened_tet10": int(straightened), "stations": int(len(P)),
+                "straightened_tet10": int(straightened), "stations": int(len(P)),
                 "thickness_range": {"intima": [float(ti.min()), float(ti.max())],
                                     "media": [float(tm.min()), float(tm.max())],
                                     "adventitia": [float(ta.min()), float(ta.max())],
                                     "wall": [float(w.min()), float(w.max())]}}
+    except RuntimeError as e:  # the checks above: a geometry that does not give three clean layers
+        raise PatientInputError(f"{where}: cannot mesh the artery from this centerline: {e}") from e
+    except Exception as e:
+        if type(e) is not Exception:  # a bug of ours, not gmsh's verdict on the geometry
+            raise
+        # gmsh's Python API raises a bare Exception when it cannot build or mesh the geometry
+        raise PatientInputError(f"{where}: gmsh cannot mesh the artery from this centerline: "
+                                f"{' '.join(str(e).split())}") from e
     finally:
         gmsh.finalize()
 

@@ -3,6 +3,7 @@ x, y, z, r (mm) and optionally `wall` (total wall thickness, mm), one station pe
 the vessel. `#` starts a comment line. This is what SimVascular's centerline tools and most
 segmentation pipelines export (after renaming the columns)."""
 import csv
+import functools
 import math
 import os
 from dataclasses import dataclass
@@ -24,10 +25,14 @@ class LumenCenterline:
     radius: np.ndarray        # (n,) lumen radius, mm
     wall: np.ndarray | None   # (n,) total wall thickness, mm (None: not in the file)
 
-    @property
+    @functools.cached_property
     def arc_length(self):
-        d = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
-        return np.concatenate([[0.0], np.cumsum(d)])
+        return arc_length(self.points)
+
+
+def arc_length(points):
+    """Cumulative arc length of a polyline (n, 3), starting at 0."""
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
 
 
 def read_centerline_csv(path):

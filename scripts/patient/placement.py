@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import UnivariateSpline
 
+from .centerline_csv import arc_length
 from .errors import PatientInputError
 
 FITPACK_TOL = 1e-3   # curfit's fixed tolerance: ε_ζ of eq. (3)
@@ -60,16 +61,12 @@ class Placement:
             "stenosis": {"arc_length": self.s_site, "point": self.site_point.tolist(),
                          "lumen_diameter": 2 * self.site_radius},
             "balloon_ends_lumen_arc_length": [self.s0, self.s1],
-            "device_centerline_length": float(_arc(self.points)[-1]),
+            "device_centerline_length": float(arc_length(self.points)[-1]),
             "balloon_start": self.balloon_start, "stent_start": self.stent_start,
             "clearance": {"balloon": self.clearance_balloon, "stent": self.clearance_stent,
                           **self.clearance_where},
             "spline": self.spline, "weight_rounds": self.weight_rounds, "max_weight": self.max_weight,
         }
-
-
-def _arc(p):
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
 
 
 def lumen_at(points, radius, s_lumen, s):
@@ -90,7 +87,7 @@ def project_on_polyline(points, q):
     dist = np.linalg.norm(q[:, None, :] - foot, axis=2)
     k = np.argmin(dist, axis=1)
     m = np.arange(len(q))
-    return dist[m, k], _arc(points)[k] + t[m, k] * np.sqrt(L2[k]), k, t[m, k]
+    return dist[m, k], arc_length(points)[k] + t[m, k] * np.sqrt(L2[k]), k, t[m, k]
 
 
 def nearest_on_polyline(points, radius, q):
@@ -197,24 +194,23 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
     head = np.array([pts[0] - t0 * h * k for k in range(n_ext, 0, -1)])
     tail = np.array([pts[-1] + t1 * h * k for k in range(1, n_ext + 1)])
     full = np.vstack([head, pts, tail])
-    sig = _arc(full)
+    sig = arc_length(full)
     # the site on the device centerline: its arc length at the spline parameter s_site
     sig_site = float(np.interp(s_site, xs, sig[n_ext:n_ext + len(xs)]))
     b_start = sig_site - 0.5 * dev.balloon_length
     st_start = sig_site - 0.5 * dev.stent_length
     if b_start < 0 or sig_site + 0.5 * dev.balloon_length > sig[-1]:
         raise PatientInputError(f"{src}: internal placement error: the balloon does not fit on its own centerline")
-    zone_b = ~stent_zone
-    kb = int(np.argmin(np.where(zone_b, clear, np.inf))) if zone_b.any() else int(np.argmin(clear))
-    ks = int(np.argmin(np.where(stent_zone, clear, np.inf))) if stent_zone.any() else kb
-    # the balloon everywhere (its radius), the stent where it is
-    clear_balloon = float((r - dist - dev.balloon_radius).min())
-    clear_stent = float((r - dist - dev.stent_radius)[stent_zone].min()) if stent_zone.any() else float("nan")
+    # reported: the balloon everywhere (its radius), the stent where it is, each with its location
+    cb = r - dist - dev.balloon_radius
+    kb = int(np.argmin(cb))
+    cs = np.where(stent_zone, r - dist - dev.stent_radius, np.inf)
+    ks = int(np.argmin(cs))
+    site_point, site_radius = lumen_at(cl.points, cl.radius, s, s_site)
     return Placement(
-        s_site=s_site, site_point=lumen_at(cl.points, cl.radius, s, s_site)[0],
-        site_radius=lumen_at(cl.points, cl.radius, s, s_site)[1], s0=s0, s1=s1, points=full,
+        s_site=s_site, site_point=site_point, site_radius=site_radius, s0=s0, s1=s1, points=full,
         sigma_site=sig_site, balloon_start=b_start, stent_start=st_start,
-        clearance_balloon=clear_balloon, clearance_stent=clear_stent,
+        clearance_balloon=float(cb[kb]), clearance_stent=float(cs[ks]) if stent_zone.any() else float("nan"),
         clearance_where={"balloon_min_at_lumen_arc_length": float(xs[kb]),
                          "stent_min_at_lumen_arc_length": float(xs[ks])},
         spline=spline_info, weight_rounds=rounds, max_weight=float(w[1:-1].max()) if len(w) > 2 else 1.0)

@@ -532,7 +532,11 @@ Mesh GmshMeshBuilder::finish(const std::string& path) {
         f.n[a] = used[f.n[a]];
       }
   m.X = std::move(X);
-  m.orient_surfaces();
+  try {
+    m.orient_surfaces();
+  } catch (const std::runtime_error& e) {  // a surface face of no volume element: name the file
+    throw std::runtime_error(path + ": " + e.what());
+  }
   return m;
 }
 

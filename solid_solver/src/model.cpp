@@ -72,10 +72,12 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
     ANGIO_PETSC(VecDuplicate(r_, &damping_diag_));
     ANGIO_PETSC(VecSet(damping_diag_, 0.0));
     const auto& parts = opt_.newton.damping_parts;
+    std::vector<char> damped(mesh_.blocks.size());  // per block, decided once
+    for (size_t b = 0; b < damped.size(); ++b)
+      damped[b] = parts.empty() || std::find(parts.begin(), parts.end(), mesh_.blocks[b].part) != parts.end();
     for (int e : local_elements_) {
       const auto& el = mesh_.elements[e];
-      if (!parts.empty() && std::find(parts.begin(), parts.end(), mesh_.blocks[el.block].part) == parts.end())
-        continue;
+      if (!damped[el.block]) continue;
       const double m = opt_.newton.damping * volume[e] / el.nn();
       for (int a = 0; a < el.nn(); ++a)
         for (int k = 0; k < 3; ++k) ANGIO_PETSC(VecSetValue(damping_diag_, 3 * perm_[el.n[a]] + k, m, ADD_VALUES));

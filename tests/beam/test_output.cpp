@@ -1,6 +1,7 @@
 // beam/summary.json through nlohmann::json: the text parses back, non-finite numbers are null
 // (never NaN tokens), integers stay integers, strings are escaped, and the keys and nesting the
 // consumers (scripts/report.py, bench_scenes.py, the scene tests) read are in place.
+#include <unistd.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -42,7 +43,7 @@ TEST(BeamSummary, NonFiniteIsNullAndStringsRoundTrip) {
   steps[1].max_bending_moment = std::numeric_limits<double>::infinity();
   StepRecord initial = record(0, 0.0, 1.5);
   const std::string status = "odd \"status\" with a back\\slash and a\nnewline";
-  const auto path = std::filesystem::temp_directory_path() / "beam_summary_json_test.json";
+  const auto path = std::filesystem::temp_directory_path() / ("beam_summary_json_test_" + std::to_string(::getpid()) + ".json");
   const std::string text = write_summary(path.string(), m, steps, false, status, 2.0, 4, initial);
 
   std::ifstream f(path);
@@ -111,7 +112,7 @@ TEST(BeamSummary, GeneratedStentBlock) {
   StepRecord initial = record(0, 0.0, 1.5);
   initial.length = 10.0;
   initial.axis_sagitta = 0.0;
-  const auto path = std::filesystem::temp_directory_path() / "beam_summary_stent_json_test.json";
+  const auto path = std::filesystem::temp_directory_path() / ("beam_summary_stent_json_test_" + std::to_string(::getpid()) + ".json");
   const auto j = nlohmann::json::parse(write_summary(path.string(), m, steps, true, "completed", 1.0, 0, initial));
   std::filesystem::remove(path);
   const auto& s = j.at("stent");

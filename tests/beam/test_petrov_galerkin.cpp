@@ -3,6 +3,7 @@
 //   tangent vs finite differences, agreement/disagreement with the consistent form at the
 //   element level, refinement of a plastic cantilever under a tip moment with both forms, the
 //   LU backends on the non-symmetric tangent, and the scene key stent.element.residual.
+#include <unistd.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -369,7 +370,7 @@ std::string scene_text(const std::string& element) {
 }
 // Loads a scene text; returns the model's residual form, or the SceneError message in `err`.
 ResidualForm load_form(const std::string& text, std::string* err) {
-  const auto path = std::filesystem::temp_directory_path() / "beam_pg_scene.yaml";
+  const auto path = std::filesystem::temp_directory_path() / ("beam_pg_scene_" + std::to_string(::getpid()) + ".yaml");
   std::ofstream(path) << text;
   ResidualForm f = kC;
   try {

@@ -1,6 +1,7 @@
 // coupling_summary.json through nlohmann::json: the keys scripts/report.py, bench_scenes.py,
 // stability.py and the scene tests read, integers as integers, non-finite numbers as null, and the
 // error message of a failed run as an escaped JSON string that reads back unchanged.
+#include <unistd.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -24,7 +25,7 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
   r.beam_time = 1.5;
   r.solid_time = 5.0;
   const std::string error = "step 5 failed: \"solid\" did not converge\n  at C:\\run\\x\ttab";
-  const auto path = std::filesystem::temp_directory_path() / "coupling_summary_json_test.json";
+  const auto path = std::filesystem::temp_directory_path() / ("coupling_summary_json_test_" + std::to_string(::getpid()) + ".json");
   ASSERT_TRUE(write_coupling_summary(path.string(), "failed", error, r, 0.5));
   std::ifstream f(path);
   std::stringstream s;

@@ -152,3 +152,16 @@ TEST(Scene, IntegersOutsideIntAreRejected) {
   EXPECT_EQ(n.child("big").integer("ok"), 2147483647L);
   expect_error([&] { n.child("big").integer("ok", 0, 100); }, {"big.ok", "an integer in 0..100"});
 }
+
+// Aliases and merge keys are not duplicates: a map reached twice through an alias is one map, and
+// `<<` may be given more than once (the launcher's loader accepts the same).
+TEST(Scene, AliasesAndMergeKeysAreNotDuplicates) {
+  const std::string path = ::testing::TempDir() + "alias_" + std::to_string(::getpid()) + ".yaml";
+  {
+    std::ofstream f(path);
+    f << "defaults: &d {E: 1.0, nu: 0.3}\nmore: &m {k: 2}\nstent:\n  material: *d\n  section: *d\n"
+         "balloon:\n  <<: *d\n  <<: *m\n";
+  }
+  EXPECT_NO_THROW(load_scene(path));
+  std::remove(path.c_str());
+}

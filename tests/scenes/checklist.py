@@ -6,7 +6,7 @@ failures = []
 
 
 def check(cond, msg):
-    print(("ok   " if cond else "FAIL ") + msg)
+    print(("ok   " if cond else "FAIL ") + msg, flush=True)
     if not cond:
         failures.append(msg)
 

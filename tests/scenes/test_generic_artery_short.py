@@ -30,13 +30,8 @@ import yaml
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "configs" / "generic_artery.yaml"
 RANK_TOL = 1e-6
-failures = []
-
-
-def check(cond, msg):
-    print(("ok   " if cond else "FAIL ") + msg, flush=True)
-    if not cond:
-        failures.append(msg)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checklist import check, failures  # noqa: E402
 
 
 def short_scene(end, steps_per_second=50):

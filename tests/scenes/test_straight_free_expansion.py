@@ -18,13 +18,8 @@ from pathlib import Path
 BIN = Path(sys.argv[1])
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "configs" / "straight_free_expansion.yaml"
-failures = []
-
-
-def check(cond, msg):
-    print(("ok   " if cond else "FAIL ") + msg, flush=True)
-    if not cond:
-        failures.append(msg)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checklist import check, failures  # noqa: E402
 
 
 def near(value, reference, rel):

@@ -116,7 +116,10 @@ class Placement(unittest.TestCase):
         inside = (sig >= plc.balloon_start) & (sig <= plc.balloon_start + self.DEV.balloon_length)
         d, r = nearest_on_polyline(cl.points, cl.radius, plc.points[inside])
         self.assertGreaterEqual((r - d - self.DEV.balloon_radius).min(), 0.02 - 1e-3)
-        self.assertGreaterEqual(plc.clearance_stent, 0.02 - 1e-9)
+        # and the stent over its own span (recomputed, not place_device's own figure)
+        st = (sig >= plc.stent_start) & (sig <= plc.stent_start + self.DEV.stent_length)
+        d, r = nearest_on_polyline(cl.points, cl.radius, plc.points[st])
+        self.assertGreaterEqual((r - d - self.DEV.stent_radius).min(), 0.02 - 1e-3)
         # devices centred on the site: the device centerline passes the site's normal plane at sigma_site
         self.assertAlmostEqual(plc.stent_start + 0.5 * self.DEV.stent_length, plc.sigma_site)
         self.assertAlmostEqual(plc.balloon_start + 0.5 * self.DEV.balloon_length, plc.sigma_site)

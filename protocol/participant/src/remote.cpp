@@ -26,12 +26,13 @@ bool Channel::alive(std::chrono::milliseconds timeout) const {
   return session_.liveliness_alive(keys::alive(run_id_, role_name_), timeout);
 }
 
-msg::Buffer Channel::call(const std::string& verb, const Build& build) {
+msg::Buffer Channel::call(const Build& build) {
   const std::uint64_t seq = sequence_.next();
   msg::Buffer request = build(msg::Header{run_id_, seq, fb::Role::Coupler});
-  // the participant checks the verb of the key against the payload (msg::check_verb): one table
-  if (const char* v = msg::request_verb(fb::GetEnvelope(request.data())->payload_type()); !v || verb != v)
-    throw std::logic_error("Channel::call: verb '" + verb + "' does not match the request built");
+  // the key's verb is the payload's (msg::request_verb, which the participant checks: one table)
+  const char* v = msg::request_verb(fb::GetEnvelope(request.data())->payload_type());
+  if (!v) throw std::logic_error("Channel::call: the message built is not a request");
+  const std::string verb = v;
   const auto t0 = Clock::now();
   msg::Buffer reply;
   try {
@@ -75,7 +76,7 @@ void account(Channel& ch, const fb::SolveStats* s) {
 }  // namespace
 
 std::string RemoteBeam::hello() {
-  auto b = ch_.call("hello", [](const msg::Header& h) { return msg::hello(h, "coupler"); });
+  auto b = ch_.call([](const msg::Header& h) { return msg::hello(h, "coupler"); });
   const auto& r = reply_as<fb::HelloReply>(b);
   if (r.protocol_version() != msg::kProtocolVersion)
     throw ParticipantError("beam participant speaks protocol " +
@@ -87,7 +88,7 @@ std::string RemoteBeam::hello() {
 void RemoteBeam::begin_step(int step, double time) {
   step_ = step;
   time_ = time;
-  ch_.call("step_begin", [&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
+  ch_.call([&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
 }
 
 SolveStats RemoteBeam::solve(const std::vector<Vec3>& q) { return solve_(q, nullptr); }
@@ -97,7 +98,7 @@ SolveStats RemoteBeam::solve_with_planes(const std::vector<Vec3>& q, const Conta
 }
 
 SolveStats RemoteBeam::solve_(const std::vector<Vec3>& q, const ContactPlanes* planes) {
-  auto b = ch_.call("solve", [&](const msg::Header& h) {
+  auto b = ch_.call([&](const msg::Header& h) {
     return msg::beam_solve_request(h, step_, iteration_, q, planes);
   });
   const auto& r = reply_as<fb::BeamSolveReply>(b);
@@ -111,15 +112,15 @@ SolveStats RemoteBeam::solve_(const std::vector<Vec3>& q, const ContactPlanes* p
 }
 
 void RemoteBeam::end_step(bool accept) {
-  ch_.call("step_end", [&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
+  ch_.call([&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
 }
 
 void RemoteBeam::finish() {
-  ch_.call("shutdown", [](const msg::Header& h) { return msg::shutdown(h, "run finished"); });
+  ch_.call([](const msg::Header& h) { return msg::shutdown(h, "run finished"); });
 }
 
 std::string RemoteSolid::hello() {
-  auto b = ch_.call("hello", [](const msg::Header& h) { return msg::hello(h, "coupler"); });
+  auto b = ch_.call([](const msg::Header& h) { return msg::hello(h, "coupler"); });
   const auto& r = reply_as<fb::HelloReply>(b);
   if (r.protocol_version() != msg::kProtocolVersion)
     throw ParticipantError("solid participant speaks protocol " +
@@ -130,11 +131,11 @@ std::string RemoteSolid::hello() {
 void RemoteSolid::begin_step(int step, double time) {
   step_ = step;
   time_ = time;
-  ch_.call("step_begin", [&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
+  ch_.call([&](const msg::Header& h) { return msg::step_begin(h, step, time, 0.0); });
 }
 
 SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply, double tolerance) {
-  auto b = ch_.call("solve", [&](const msg::Header& h) {
+  auto b = ch_.call([&](const msg::Header& h) {
     return msg::solid_solve_request(h, step_, iteration_, pts, tolerance);
   });
   const auto& r = reply_as<fb::SolidSolveReply>(b);
@@ -147,11 +148,11 @@ SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply, doub
 }
 
 void RemoteSolid::end_step(bool accept) {
-  ch_.call("step_end", [&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
+  ch_.call([&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
 }
 
 void RemoteSolid::finish() {
-  ch_.call("shutdown", [](const msg::Header& h) { return msg::shutdown(h, "run finished"); });
+  ch_.call([](const msg::Header& h) { return msg::shutdown(h, "run finished"); });
 }
 
 }  // namespace angio::participant

@@ -145,7 +145,7 @@ long Node::integer(const std::string& key, long min, long max) const {
   if (min != imin && max != imax)
     what += " in " + std::to_string(min) + ".." + std::to_string(max);
   else if (min != imin)
-    what += " >= " + std::to_string(min) + (max == imax ? " (at most " + std::to_string(imax) + ")" : "");
+    what += " >= " + std::to_string(min) + " (at most " + std::to_string(imax) + ")";
   else if (max != imax)
     what += " <= " + std::to_string(max);
   Node c = child(key, what);
@@ -235,22 +235,29 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
-// Every map of the document: a key given twice is an error naming both lines.
-void check_unique_keys(const YAML::Node& n, const std::string& file, const std::string& path) {
+// Every map of the document: a key given twice is an error naming both lines (the launcher's
+// SceneLoader applies the same rule). A node reached again through an alias is checked once (its
+// anchor's mark identifies it), so an alias bomb costs linear time; merge keys (`<<`) may repeat.
+void check_unique_keys(const YAML::Node& n, const std::string& file, const std::string& path,
+                       std::set<std::pair<int, int>>& seen) {
+  if (!(n.IsMap() || n.IsSequence()) || !seen.emplace(n.Mark().line, n.Mark().column).second) return;
   if (n.IsMap()) {
     std::map<std::string, int> first;
     for (const auto& kv : n) {
       const std::string k = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
       const std::string sub = path.empty() ? k : path + "." + k;
       const int line = kv.first.Mark().line + 1;
-      if (const auto it = first.find(k); it != first.end())
-        throw SceneError(file + ": " + sub + ": expected each key once in a map, got it twice (lines " +
-                         std::to_string(it->second) + " and " + std::to_string(line) + ")");
-      first.emplace(k, line);
-      check_unique_keys(kv.second, file, sub);
+      if (k != "<<") {
+        if (const auto it = first.find(k); it != first.end())
+          throw SceneError(file + ": " + sub + ": expected each key once in a map, got it twice (lines " +
+                           std::to_string(it->second) + " and " + std::to_string(line) + ")");
+        first.emplace(k, line);
+      }
+      check_unique_keys(kv.second, file, sub, seen);
     }
-  } else if (n.IsSequence()) {
-    for (std::size_t i = 0; i < n.size(); ++i) check_unique_keys(n[i], file, path + "[" + std::to_string(i) + "]");
+  } else {
+    for (std::size_t i = 0; i < n.size(); ++i)
+      check_unique_keys(n[i], file, path + "[" + std::to_string(i) + "]", seen);
   }
 }
 }  // namespace
@@ -285,7 +292,8 @@ Node load_scene(const std::string& path) {
   }
   Node n(root, path, "");
   if (!root.IsMap()) n.fail("a YAML map at the top level");
-  check_unique_keys(root, path, "");
+  std::set<std::pair<int, int>> seen;
+  check_unique_keys(root, path, "", seen);
   return n;
 }
 

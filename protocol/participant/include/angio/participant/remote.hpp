@@ -40,10 +40,11 @@ class Channel {
           std::chrono::milliseconds timeout, recording::Recorder* recorder);
 
   using Build = std::function<msg::Buffer(const msg::Header&)>;
-  // Sends the request built by `build` to angio/<run>/<role>/<verb>; returns the verified reply
+  // Sends the request built by `build` to angio/<run>/<role>/<verb>, the verb being the payload's
+  // (msg::request_verb); returns the verified reply
   // bytes (open them with msg::open). Throws ParticipantError on an Error reply and
   // transport::TimeoutError (with the role and verb) when no reply came in time.
-  msg::Buffer call(const std::string& verb, const Build& build);
+  msg::Buffer call(const Build& build);
   // True while the participant's liveliness token is visible.
   bool alive(std::chrono::milliseconds timeout) const;
   // The reply timeout of later calls (the coupler's error path shortens it: a participant that went
