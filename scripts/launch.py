@@ -24,6 +24,7 @@ import re
 import shlex
 import shutil
 import signal
+import secrets
 import socket
 import stat
 import subprocess
@@ -284,6 +285,19 @@ def make_run_dir(run_dir, explicit):
         die(f"{run_dir}: cannot create the run directory: {e.strerror}")
 
 
+def write_run_key(path):
+    """A new secret for this launch (README "Security"): every message of the run carries an
+    HMAC-SHA256 tag under it, and the executables read it from <run dir>/run.key, so only processes
+    that can read this owner-only file can speak for the coupler or a participant."""
+    try:
+        path.unlink(missing_ok=True)  # a reused run directory: never the last launch's key
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(secrets.token_hex(32) + "\n")
+    except OSError as e:
+        die(f"{path}: cannot write the run's key: {e.strerror}")
+
+
 def lock_run_dir(run_dir):
     """Holds <run_dir>/launch.lock (flock) until the launcher exits. The kernel drops the lock when
     the launcher dies however it dies, so a leftover file never blocks a later launch. Returns the
@@ -499,6 +513,7 @@ def main():
 
     plan = []
     if has_stent and has_solid:
+        write_run_key(run_dir / "run.key")
         endpoint = pick_endpoint(run_dir, args.transport)
         coupled = ["--endpoint", endpoint, "--run-id", run_id]
         coupler = coupler_exe + common + coupled + (["--record"] if args.record else [])

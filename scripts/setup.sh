@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread
   petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev libhdf5-dev
-  flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev nlohmann-json3-dev
+  flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev nlohmann-json3-dev libssl-dev
   libgtest-dev googletest
   python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml python3-gmsh
 )

@@ -17,6 +17,7 @@
 #include "angio/coupler/summary.hpp"
 #include "angio/participant/keys.hpp"
 #include "angio/participant/remote.hpp"
+#include "angio/participant/role_server.hpp"
 #include "angio/recording/recording.hpp"
 #include "angio/scene/load_curve.hpp"
 #include "angio/transport.hpp"
@@ -52,6 +53,8 @@ int run(const cli::Parser& args) {
     balloon_pressure = scene::scaled_curve(*b, "pressure", curves);
   if (args.has("check")) return 0;  // time, load curves and coupling settings are valid
   const fs::path run_dir = args.get("run-dir");
+  // the run's key before anything is written: a missing or loose key file is bad input (exit 2)
+  const msg::RunKey key = participant::run_key(args);
   fs::create_directories(run_dir);
   const std::string run_id = args.get("run-id");
   const auto timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
@@ -63,23 +66,24 @@ int run(const cli::Parser& args) {
 
   auto session = transport::Session::open({{args.get("endpoint")}, {}});
   auto token = session.declare_liveliness_token(participant::keys::alive(run_id, "coupler"));
-  participant::Channel beam_ch(session, run_id, fb::Role::Beam, timeout, recorder.get());
-  participant::Channel solid_ch(session, run_id, fb::Role::Solid, timeout, recorder.get());
+  participant::Channel beam_ch(session, run_id, fb::Role::Beam, timeout, recorder.get(), key);
+  participant::Channel solid_ch(session, run_id, fb::Role::Solid, timeout, recorder.get(), key);
   participant::RemoteBeam beam(beam_ch);
   participant::RemoteSolid solid(solid_ch);
-
-  const std::string beam_sw = beam.hello();
-  const std::string solid_sw = solid.hello();
-  LOG_INFO("run " << run_id << ": beam " << beam_sw << " (" << beam.sample_points().size()
-                  << " contact sample points), solid " << solid_sw << "; " << time.steps
-                  << " steps to t = " << time.end << " s, " << settings.scheme << " coupling with " << settings.acceleration
-                  << " acceleration");
 
   coupler::StepCsv csv((run_dir / "coupling.csv").string());
   auto acc = coupler::make_acceleration(settings);
   coupler::RunReport report;
   double messaging_before = 0.0;
   try {
+    // the handshake inside the error path: a participant that is missing, silent or without the
+    // run's key fails the run like any later exchange (summary "failed", exit 3)
+    const std::string beam_sw = beam.hello();
+    const std::string solid_sw = solid.hello();
+    LOG_INFO("run " << run_id << ": beam " << beam_sw << " (" << beam.sample_points().size()
+                    << " contact sample points), solid " << solid_sw << "; " << time.steps << " steps to t = "
+                    << time.end << " s, " << settings.scheme << " coupling with " << settings.acceleration
+                    << " acceleration");
     report = coupler::run_coupled(beam, solid, time, settings, *acc, [&](const coupler::StepReport& r) {
       const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
       const double step_messaging = messaging - messaging_before;

@@ -66,6 +66,18 @@ int main(int argc, char** argv) {
       PetscFinalize();
       return 0;
     }
+#ifdef ANGIO_SOLID_HAVE_SERVE
+    // the run's key file on every rank before the model is built: missing or loose is bad input
+    if (!cli.maybe("endpoint").value_or("").empty()) {
+      try {
+        angio::participant::run_key(cli);
+      } catch (const std::exception& e) {
+        if (rank == 0) LOG_ERROR(e.what());
+        PetscFinalize();
+        return 2;
+      }
+    }
+#endif
     try {
       angio::solid::SolidRunner runner(PETSC_COMM_WORLD, std::move(scene), cli.get("run-dir"));
       angio::solid::ContactSetup contact(runner, contact_spec);

@@ -10,9 +10,15 @@
 4. a coupler without participants fails with a timeout error instead of hanging.
 5. a frozen participant (SIGSTOP) stops the run within --timeout + a few seconds, the coupler names
    it, the launcher passes the coupler's diagnosis on, the summary says failed, nothing is left.
+6. peer authentication (README "Security"): a foreign replier on the solid's keys answering every
+   request first does not change the run (same coupling history as run 1); a forged coupler
+   sending the recorded requests with another key gets no answer; a participant with another key
+   file is refused by name; a key file readable by others, or none, is bad input (exit 2, named).
 """
 import json
 import csv
+import os
+import secrets
 import signal
 import subprocess
 import sys
@@ -38,6 +44,14 @@ def launch(run_dir, *extra, timeout=120):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
 
 
+def write_key(path):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(secrets.token_hex(32) + "\n")
+    return path
+
+
 def rows(run_dir):
     with open(run_dir / "coupling.csv") as f:
         return list(csv.DictReader(f))
@@ -46,6 +60,7 @@ def rows(run_dir):
 with tempfile.TemporaryDirectory() as tmp:
     tmp = Path(tmp)
     spring = str(BIN / "spring_participant")
+    rec_rows = []
     # 1. real exchange with an analytic answer
     r = launch(tmp / "springs", "--record", "--run-id", "springs-1",
                "--beam-cmd", f"{spring} --role beam", "--solid-cmd", f"{spring} --role solid")
@@ -102,6 +117,7 @@ with tempfile.TemporaryDirectory() as tmp:
           f"{n_rows} rows in coupling.csv")
 
     # 4. no participants: the coupler times out with a clear error
+    write_key(tmp / "alone" / "run.key")
     t0 = time.time()
     r4 = subprocess.run([str(BIN / "coupler"), "--scene", str(SCENE), "--run-dir", str(tmp / "alone"),
                          "--endpoint", f"unixsock-stream/{tmp}/alone.sock", "--run-id", "alone", "--timeout", "3"],
@@ -143,5 +159,70 @@ with tempfile.TemporaryDirectory() as tmp:
     check(not left, f"frozen beam: no process of the run is left ({left})")
     for pid in left:
         subprocess.run(["kill", "-KILL", pid])
+
+    # 6. peer authentication
+    keys = ["step", "time", "coupling_iterations", "residual", "omega", "n_active", "contact_force_x"]
+    rec = tmp / "springs" / "exchanges.angiorec"
+    guarded = tmp / "guarded"
+    cmd = LAUNCH + [str(SCENE), "--run-dir", str(guarded), "--build-dir", str(BIN.parent), "--timeout", "30",
+                    "--run-id", "springs-1",  # the recording's: the forged coupler's requests name this run
+                    "--beam-cmd", f"{spring} --role beam --delay 0.3", "--solid-cmd", f"{spring} --role solid"]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    sock = guarded / "coupler.sock"
+    for _ in range(100):
+        if sock.exists():
+            break
+        time.sleep(0.1)
+    ep = f"unixsock-stream/{sock}"
+    foreign = subprocess.Popen([str(BIN / "transport_test_server"), "--connect", ep, "--key", "angio/springs-1/solid/**",
+                                "--token", "angio/springs-1/foreign", "--max-seconds", "60"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    out, err = p.communicate(timeout=120)
+    foreign.kill()
+    foreign.wait()
+    check(p.returncode == 0, f"foreign replier answering first: the run completes (rc {p.returncode}) {err.strip()[-400:]}")
+    if p.returncode == 0 and rec_rows:
+        a = [[row[k] for k in keys] for row in rec_rows]
+        b = [[row[k] for k in keys] for row in rows(guarded)]
+        check(a == b, "foreign replier answering first: the coupling history equals run 1's")
+
+    # a forged coupler (the recorded requests, sealed with another key) gets no answer
+    ep = f"unixsock-stream/{tmp}/forged.sock"
+    participant = subprocess.Popen([spring, "--role", "beam", "--scene", str(SCENE), "--endpoint", ep,
+                                    "--run-id", "springs-1", "--timeout", "1", "--run-dir", str(tmp / "forged"),
+                                    "--key-file", str(write_key(tmp / "real.key"))],
+                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    forged = subprocess.run([str(BIN / "replay_driver"), "--recording", str(rec), "--role", "beam", "--endpoint", ep,
+                             "--key-file", str(write_key(tmp / "forged.key")), "--timeout", "3"],
+                            capture_output=True, text=True, timeout=60)
+    try:
+        plog, _ = participant.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        participant.kill()
+        plog, _ = participant.communicate()
+    check(forged.returncode != 0 and "not authenticated" in forged.stderr,
+          f"a forged coupler gets no answer (rc {forged.returncode}): {forged.stderr.strip()[-300:]}")
+    check("refused: message is not authenticated" in plog,
+          f"the participant refuses the forged request and says so: {plog.strip()[-300:]}")
+
+    # a participant started with another key file: the coupler stops at the handshake and says why
+    r6 = launch(tmp / "otherkey", "--timeout", "5", "--beam-cmd",
+                f"{spring} --role beam --key-file {write_key(tmp / 'other.key')}", "--solid-cmd", f"{spring} --role solid",
+                timeout=60)
+    check(r6.returncode != 0 and "not authenticated" in r6.stderr and "beam" in r6.stderr,
+          f"a participant with another key is refused by name (rc {r6.returncode}): {r6.stderr.strip()[-400:]}")
+
+    # key files: readable by others, or missing, is bad input naming the file
+    loose = write_key(tmp / "loose" / "run.key")
+    os.chmod(loose, 0o644)
+    for name, run_dir, what in (("loose", tmp / "loose", "mode 0644"), ("missing", tmp / "nokey", "run.key")):
+        r = subprocess.run([str(BIN / "coupler"), "--scene", str(SCENE), "--run-dir", str(run_dir),
+                            "--endpoint", f"unixsock-stream/{tmp}/{name}.sock", "--run-id", name, "--timeout", "3"],
+                           capture_output=True, text=True, timeout=30)
+        check(r.returncode == 2 and what in r.stderr and str(run_dir / "run.key") in r.stderr,
+              f"{name} key file: exit 2 naming the file (rc {r.returncode}): {r.stderr.strip()[-300:]}")
+    launched_key = guarded / "run.key"
+    check(launched_key.stat().st_mode & 0o777 == 0o600 and len(launched_key.read_text().strip()) == 64,
+          "the launcher writes a 0600 key of 64 hex digits into the run directory")
 
 sys.exit(1 if failures else 0)

@@ -12,6 +12,7 @@
 """
 import json
 import os
+import secrets
 import struct
 import subprocess
 import sys
@@ -66,14 +67,19 @@ with tempfile.TemporaryDirectory() as tmp:
                           "--solid-cmd", f"{replay} --role solid --recording {REC}"])
         check(r.returncode == 0, f"(a) coupler + replay participants reproduce the recording (rc {r.returncode})\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
 
-        # 2b/c. real solvers driven by the recorded requests
+        # 2b/c. real solvers driven by the recorded requests; driver and solver share one key file
+        key = tmp / "drive.key"
+        fd = os.open(key, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(secrets.token_hex(32) + "\n")
         for role, exe in (("beam", [str(BIN / "beam_solver")]), ("solid", MPIRUN + [str(BIN / "solid_solver")])):
             ep = f"unixsock-stream/{tmp}/{role}.sock"
             driver = subprocess.Popen([str(BIN / "replay_driver"), "--recording", str(REC), "--role", role,
-                                       "--endpoint", ep, "--tolerance", TOL_SOLVER, "--timeout", "120"],
+                                       "--endpoint", ep, "--tolerance", TOL_SOLVER, "--timeout", "120",
+                                       "--key-file", str(key)],
                                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
             solver = run(exe + ["--scene", str(SCENE), "--run-dir", str(tmp / f"drive_{role}"), "--endpoint", ep,
-                                "--run-id", rec_id, "--timeout", "60"], timeout=300)
+                                "--run-id", rec_id, "--timeout", "60", "--key-file", str(key)], timeout=300)
             out, _ = driver.communicate(timeout=120)
             check(driver.returncode == 0 and solver.returncode == 0,
                   f"({'b' if role == 'beam' else 'c'}) real {role} solver reproduces the recorded replies "

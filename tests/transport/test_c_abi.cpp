@@ -13,7 +13,7 @@ TEST(TransportCAbi, NullArgumentsAreReportedNotFatal) {
   EXPECT_NE(std::string(az_last_error()).find("NULL"), std::string::npos) << az_last_error();
 
   az_bytes out{nullptr, 0};
-  EXPECT_EQ(az_request(nullptr, "a/b", nullptr, 0, 10, &out), AZ_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(az_request(nullptr, "a/b", nullptr, 0, 10, nullptr, nullptr, &out), AZ_ERR_INVALID_ARGUMENT);
   EXPECT_EQ(out.data, nullptr);
 
   const char* listen[] = {nullptr};
@@ -40,6 +40,6 @@ TEST(TransportCAbi, BadKeyExpressionIsAnError) {
   EXPECT_EQ(q, nullptr);
   EXPECT_NE(std::string(az_last_error()).find("bad//key"), std::string::npos) << az_last_error();
   az_bytes out{nullptr, 0};
-  EXPECT_LT(az_request(s, "", nullptr, 0, 100, &out), 0);
+  EXPECT_LT(az_request(s, "", nullptr, 0, 100, nullptr, nullptr, &out), 0);
   EXPECT_EQ(az_session_close(s), AZ_OK);
 }

@@ -23,6 +23,10 @@ Parser& Parser::add_common() {
        "zenoh endpoint of the coupler, e.g. unixsock-stream//path/c.sock or tcp/127.0.0.1:7447", ""});
   add({"run-id", "ID", "run id shared by all processes of one run (key prefix, envelope check)",
        "run"});
+  add({"key-file", "FILE",
+       "the run's secret key (64 hex digits, mode 0600) that authenticates every message; default <run-dir>/run.key, "
+       "which the launcher writes",
+       ""});
   add({"timeout", "SECONDS", "give up when the peer is silent or gone this long", "600"});
   add({"log-level", "LEVEL", "debug, info, warn or error", "info"});
   add({"check", "", "read and check the scene (and build the model), then exit: 0 valid, 2 the error", ""});

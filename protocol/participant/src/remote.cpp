@@ -14,13 +14,14 @@ namespace {
 }  // namespace
 
 Channel::Channel(const transport::Session& session, std::string run_id, fb::Role role,
-                 std::chrono::milliseconds timeout, recording::Recorder* recorder)
+                 std::chrono::milliseconds timeout, recording::Recorder* recorder, msg::RunKey key)
     : session_(session),
       run_id_(std::move(run_id)),
       role_(role),
       role_name_(msg::role_key(role)),
       timeout_(timeout),
-      recorder_(recorder) {}
+      recorder_(recorder),
+      key_(key) {}
 
 bool Channel::alive(std::chrono::milliseconds timeout) const {
   return session_.liveliness_alive(keys::alive(run_id_, role_name_), timeout);
@@ -34,13 +35,34 @@ msg::Buffer Channel::call(const Build& build) {
   if (!v) throw std::logic_error("Channel::call: the message built is not a request");
   const std::string verb = v;
   const auto t0 = Clock::now();
+  // Replies without the run's tag (a foreign replier on the key, or a participant started with
+  // another key file) are skipped, counted and named if no authentic reply comes.
+  int refused = 0;
+  const auto authentic = [&](transport::ByteView bytes) {
+    const bool ok = key_.authentic(bytes);
+    refused += ok ? 0 : 1;
+    return ok;
+  };
   msg::Buffer reply;
   try {
-    reply = session_.request(keys::request(run_id_, role_name_, verb), request, timeout_);
+    const msg::Buffer sealed = session_.request(keys::request(run_id_, role_name_, verb), key_.seal(request),
+                                                timeout_, authentic);
+    const auto envelope = key_.unseal(sealed);
+    reply.assign(envelope.begin(), envelope.end());
+  } catch (const transport::RemoteError& e) {
+    // our role servers answer only one request with a transport-level error: one they could not
+    // authenticate (and no foreign replier's error is taken while ours may still come)
+    throw ParticipantError("the " + role_name_ + " participant refused '" + verb + "': " + e.what() +
+                           " (it does not read the run's key file; do all processes read the same "
+                           "--key-file or <run-dir>/run.key?)");
   } catch (const transport::TimeoutError& e) {
-    throw transport::TimeoutError("the " + role_name_ + " participant did not answer '" + verb +
-                                  "' within " + std::to_string(timeout_.count() / 1000.0) +
-                                  " s (is it running? see its log): " + e.what());
+    throw transport::TimeoutError(
+        "the " + role_name_ + " participant did not answer '" + verb + "' within " +
+        std::to_string(timeout_.count() / 1000.0) + " s (is it running? see its log): " + e.what() +
+        (refused ? "; " + std::to_string(refused) +
+                       " replies refused as not authenticated by the run's key (do all processes read "
+                       "the same key file, --key-file or <run-dir>/run.key?)"
+                 : std::string()));
   }
   timing_.round_trip = seconds_since(t0);
   timing_.solver_time = 0.0;

@@ -1,6 +1,7 @@
 #include "angio/participant/role_server.hpp"
 
 #include <chrono>
+#include <filesystem>
 #include <functional>
 
 #include "angio/common/clock.hpp"
@@ -21,6 +22,7 @@ using Dispatch = std::function<msg::Buffer(const fb::Envelope&, const msg::Heade
 // coupler's liveliness token and the silence timeout so that a vanished coupler ends the process
 // with a clear error instead of a hang.
 int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
+  if (!o.key) throw std::logic_error("serve: ServeOptions without the run's key (use serve_options)");
   const std::string name = msg::role_key(role);
   std::optional<transport::Session> session;
   try {
@@ -61,20 +63,31 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
       }
       continue;
     }
+    // A request without the run's tag comes from a process that cannot read the run's key file:
+    // it is not answered (an answer, even an Error, would be a message sealed with our key) and
+    // does not count as the coupler being heard.
+    std::span<const std::uint8_t> bytes;
+    try {
+      bytes = o.key->unseal(q->payload());
+    } catch (const msg::ProtocolError& e) {
+      LOG_WARN("request on " << q->key() << " refused: " << e.what());
+      q->reply_error("not authenticated");
+      continue;
+    }
     last_heard = Clock::now();
     msg::Header h{o.run_id, 0, role};
     bool stop = false;
     try {
-      const fb::Envelope& env = msg::open(q->payload(), o.run_id);
+      const fb::Envelope& env = msg::open(bytes, o.run_id);
       h.sequence = env.sequence();
       msg::check_verb(env, q->key());
       sequence.check_request(env);
       state.check(env);
-      q->reply(dispatch(env, h, stop));
+      q->reply(o.key->seal(dispatch(env, h, stop)));
     } catch (const std::exception& e) {
       // A bad message or a failing solver is answered with an Error; the coupler decides.
       LOG_ERROR("request on " << q->key() << " failed: " << e.what());
-      q->reply(msg::error(h, e.what()));
+      q->reply(o.key->seal(msg::error(h, e.what())));
     }
     if (stop) return 0;
   }
@@ -94,12 +107,19 @@ msg::Buffer common(const fb::Envelope& env, const msg::Header& h, bool& stop,
 
 }  // namespace
 
+msg::RunKey run_key(const cli::Parser& args) {
+  const std::string file = args.maybe("key-file").value_or("");
+  return msg::RunKey::read(file.empty() ? std::filesystem::path(args.get("run-dir")) / "run.key"
+                                        : std::filesystem::path(file));
+}
+
 ServeOptions serve_options(const cli::Parser& args, std::string software) {
   ServeOptions o;
   o.endpoint = args.get("endpoint");
   o.run_id = args.get("run-id");
   o.timeout = std::chrono::milliseconds(static_cast<long>(1000.0 * args.number("timeout")));
   o.software = std::move(software);
+  o.key = run_key(args);
   return o;
 }
 

@@ -8,7 +8,9 @@
 #include "angio/common/cli.hpp"
 #include "angio/common/log.hpp"
 #include "angio/messages/convert.hpp"
+#include "angio/messages/seal.hpp"
 #include "angio/participant/keys.hpp"
+#include "angio/participant/role_server.hpp"
 #include "angio/replay/replay_participants.hpp"
 #include "angio/transport.hpp"
 
@@ -55,6 +57,9 @@ int main(int argc, char** argv) {
     const auto rec = recording::read(args.get("recording"));
     const double tol = args.number("tolerance");
     const auto timeout = std::chrono::milliseconds(static_cast<long>(1000 * args.number("timeout")));
+    // the participant driven must read the same key file (--key-file, or <run-dir>/run.key of both)
+    const msg::RunKey key = participant::run_key(args);
+    const auto authentic = [&](transport::ByteView b) { return key.authentic(b); };
     auto session = transport::Session::open({{args.get("endpoint")}, {}});
     auto token = session.declare_liveliness_token(participant::keys::alive(rec.run_id, "coupler"));
     double worst = 0.0;
@@ -62,9 +67,9 @@ int main(int argc, char** argv) {
     for (const auto& e : rec.exchanges) {
       if (e.role != r) continue;
       // The recording keeps the verb the coupler sent the request to.
-      const std::string key = participant::keys::request(rec.run_id, role, e.verb);
-      const auto live_bytes = session.request(key, e.request, timeout);
-      const fb::Envelope& live = msg::open(live_bytes, rec.run_id);
+      const std::string key_expr = participant::keys::request(rec.run_id, role, e.verb);
+      const auto live_bytes = session.request(key_expr, key.seal(e.request), timeout, authentic);
+      const fb::Envelope& live = msg::open(key.unseal(live_bytes), rec.run_id);
       if (const auto* err = live.payload_as_Error())
         throw replay::ReplayMismatch("exchange " + std::to_string(n) + ": participant error: " +
                                      flatbuffers::GetString(err->message()));

@@ -28,10 +28,21 @@ std::string timeout_message(const std::string& key, milliseconds timeout, bool r
 // One az_request call waiting at most `wait`: the reply, or nullopt when the request finished
 // without any (no queryable reachable). Throws TimeoutError naming the caller's `timeout` when
 // the queryable did not answer in time, RemoteError / TransportError on failures.
+// The C callback in front of Session::Accept: exceptions must not cross into Rust.
+int accept_trampoline(void* ctx, const std::uint8_t* data, std::size_t len) {
+  try {
+    return (*static_cast<const Session::Accept*>(ctx))(ByteView(data, len)) ? 1 : 0;
+  } catch (...) {
+    return 0;
+  }
+}
+
 std::optional<Bytes> attempt(az_session* s, const std::string& key, ByteView payload, milliseconds wait,
-                             milliseconds timeout) {
+                             milliseconds timeout, const Session::Accept& accept = {}) {
   az_bytes raw{nullptr, 0};
-  const int rc = az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(wait), &raw);
+  const int rc = az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(wait),
+                            accept ? accept_trampoline : nullptr,
+                            accept ? const_cast<Session::Accept*>(&accept) : nullptr, &raw);
   const OwnedBuffer reply = OwnedBuffer::adopt(raw);
   switch (rc) {
     case AZ_OK:
@@ -52,12 +63,12 @@ Bytes Session::request_once(const std::string& key, ByteView payload, millisecon
   throw NoReplyError("request to '" + key + "' finished without reply (no queryable reachable)");
 }
 
-Bytes Session::request(const std::string& key, ByteView payload, milliseconds timeout) const {
+Bytes Session::request(const std::string& key, ByteView payload, milliseconds timeout, const Accept& accept) const {
   const auto deadline = Clock::now() + detail::clamp_timeout(timeout);
   for (;;) {
     const auto remaining = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
     if (remaining <= milliseconds::zero()) throw TimeoutError(timeout_message(key, timeout, false));
-    if (auto reply = attempt(checked(), key, payload, remaining, timeout)) return std::move(*reply);
+    if (auto reply = attempt(checked(), key, payload, remaining, timeout, accept)) return std::move(*reply);
     // No queryable known yet (peer still connecting or not started): try again.
     std::this_thread::sleep_for(std::min(no_route_backoff, remaining));
   }

@@ -102,13 +102,19 @@ void az_query_drop(az_query* q);
 
 /* --- request ------------------------------------------------------------------------------ */
 
-/* Sends data to the queryable on keyexpr and waits up to timeout_ms for its first reply.
+/* Decides whether a reply is the one awaited (nonzero) or is skipped (0), e.g. a reply that does
+ * not carry the run's authentication tag; must not throw. */
+typedef int (*az_accept_fn)(void* ctx, const uint8_t* data, size_t len);
+
+/* Sends data to the queryable on keyexpr and waits up to timeout_ms for its first reply that
+ * `accept` takes (every reply when accept is NULL); replies it refuses and error replies from
+ * other repliers are skipped while another may still come.
  * AZ_OK: *out_reply holds the reply. AZ_TIMEOUT: no reply within timeout_ms.
  * AZ_NO_REPLY: finished without reply, usually because no matching queryable is reachable
  * (returned immediately in that case; callers that wait for a peer retry).
  * AZ_ERR_REPLY: the replier sent an error reply (its message is in az_last_error()). */
 int az_request(const az_session* s, const char* keyexpr, const uint8_t* data, size_t len,
-               uint64_t timeout_ms, az_bytes* out_reply);
+               uint64_t timeout_ms, az_accept_fn accept, void* accept_ctx, az_bytes* out_reply);
 
 /* --- publish / subscribe ------------------------------------------------------------------ */
 

@@ -1,6 +1,6 @@
 //! Request/reply: queryables delivering incoming queries to a FIFO, and requests (get).
 
-use std::ffi::{c_char, c_int, CString};
+use std::ffi::{c_char, c_int, c_void, CString};
 use std::time::Instant;
 
 use zenoh::handlers::FifoChannelHandler;
@@ -142,8 +142,12 @@ pub unsafe extern "C" fn az_query_drop(q: *mut az_query) {
 // Request (get)
 // ---------------------------------------------------------------------------------------------
 
+/// Decides whether a reply is the awaited one (nonzero) or is skipped (0); must not unwind.
+pub type az_accept_fn = Option<unsafe extern "C" fn(*mut c_void, *const u8, usize) -> c_int>;
+
 /// Sends `data` to the queryable(s) on `keyexpr` and waits up to `timeout_ms` for the first
-/// reply. AZ_OK: `*out_reply` holds it (free with az_bytes_free). AZ_TIMEOUT: nothing within the
+/// reply that `accept` takes (any reply when it is NULL). Refused replies, and error replies while
+/// a callback filters, are skipped: a foreign replier on the key cannot pre-empt the real one. AZ_OK: `*out_reply` holds it (free with az_bytes_free). AZ_TIMEOUT: nothing within the
 /// timeout. AZ_NO_REPLY: the query completed with no reply (typically: no matching queryable
 /// reachable right now). AZ_ERR_REPLY: the replier sent an error (message in az_last_error).
 #[no_mangle]
@@ -153,6 +157,8 @@ pub unsafe extern "C" fn az_request(
     data: *const u8,
     len: usize,
     timeout_ms: u64,
+    accept: az_accept_fn,
+    accept_ctx: *mut c_void,
     out_reply: *mut az_bytes,
 ) -> c_int {
     guard(|| {
@@ -172,11 +178,37 @@ pub unsafe extern "C" fn az_request(
             .timeout(ms(timeout_ms) + ZENOH_QUERY_TIMEOUT_GRACE)
             .wait()
             .map_err(|e| Fail::err(format!("cannot send request to '{key}': {e}")))?;
-        match replies.recv_deadline(deadline) {
-            Ok(Some(reply)) => reply_to_status(reply, key, out_reply),
-            Ok(None) => Ok(AZ_TIMEOUT),
-            // Channel closed without any reply: zenoh finalised the query (no route / no answer).
-            Err(_) => Ok(AZ_NO_REPLY),
+        let Some(accept) = accept else {
+            return match replies.recv_deadline(deadline) {
+                Ok(Some(reply)) => reply_to_status(reply, key, out_reply),
+                Ok(None) => Ok(AZ_TIMEOUT),
+                // Channel closed without any reply: zenoh finalised the query (no route / no answer).
+                Err(_) => Ok(AZ_NO_REPLY),
+            };
+        };
+        let mut last_error: Option<Fail> = None;
+        loop {
+            match replies.recv_deadline(deadline) {
+                Ok(Some(reply)) => match reply.result() {
+                    Ok(sample) => {
+                        let bytes = zbytes_to_vec(sample.payload());
+                        if accept(accept_ctx, bytes.as_ptr(), bytes.len()) != 0 {
+                            *out_reply = az_bytes::from_vec(bytes);
+                            return Ok(AZ_OK);
+                        }
+                    }
+                    Err(err) => {
+                        let msg = String::from_utf8_lossy(&err.payload().to_bytes()).into_owned();
+                        last_error = Some(Fail(AZ_ERR_REPLY, format!("error reply from '{key}': {msg}")));
+                    }
+                },
+                Ok(None) => return Ok(AZ_TIMEOUT),
+                // Finalised: every replier has answered and none was taken.
+                Err(_) => return match last_error {
+                    Some(fail) => Err(fail),
+                    None => Ok(AZ_NO_REPLY),
+                },
+            }
         }
     })
 }

@@ -1,5 +1,6 @@
 // Command-line options shared by the three executables, so every process answers to the same
-// flags: --scene FILE, --run-dir DIR, --endpoint E, --run-id ID, --timeout S, --log-level L, --check.
+// flags: --scene FILE, --run-dir DIR, --endpoint E, --run-id ID, --key-file F, --timeout S,
+// --log-level L, --check.
 #pragma once
 
 #include <functional>
@@ -28,7 +29,7 @@ class Parser {
  public:
   Parser(std::string program, std::string summary);
   Parser& add(Option o);
-  Parser& add_common();  // scene, run-dir, endpoint, run-id, timeout, log-level, debug-log
+  Parser& add_common();  // scene, run-dir, endpoint, run-id, key-file, timeout, log-level, check
 
   // Returns false when --help was given (usage already printed). Throws UsageError otherwise.
   bool parse(int argc, char** argv);

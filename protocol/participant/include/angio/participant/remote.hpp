@@ -9,6 +9,7 @@
 #include <string>
 
 #include "angio/messages/builders.hpp"
+#include "angio/messages/seal.hpp"
 #include "angio/participant/beam_participant.hpp"
 #include "angio/participant/solid_participant.hpp"
 
@@ -33,11 +34,13 @@ struct ExchangeTiming {
   double solver_time = 0.0;  // s, as reported by the participant (solve replies only)
 };
 
-// One request/reply conversation with one role: sequence numbers, verification, recording.
+// One request/reply conversation with one role: sequence numbers, authentication (every request
+// sealed with the run's key, only replies that carry its tag are taken), verification, recording
+// (of the envelopes, without tags).
 class Channel {
  public:
   Channel(const transport::Session& session, std::string run_id, fb::Role role,
-          std::chrono::milliseconds timeout, recording::Recorder* recorder);
+          std::chrono::milliseconds timeout, recording::Recorder* recorder, msg::RunKey key);
 
   using Build = std::function<msg::Buffer(const msg::Header&)>;
   // Sends the request built by `build` to angio/<run>/<role>/<verb>, the verb being the payload's
@@ -65,6 +68,7 @@ class Channel {
   std::string role_name_;
   std::chrono::milliseconds timeout_;
   recording::Recorder* recorder_;
+  msg::RunKey key_;
   msg::Sequence sequence_;
   ExchangeTiming timing_;
   double messaging_ = 0.0;

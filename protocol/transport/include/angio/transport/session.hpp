@@ -1,6 +1,7 @@
 #pragma once
 // A zenoh peer session: the entry point that opens the connection and declares everything else.
 #include <chrono>
+#include <functional>
 #include <string>
 
 #include "angio/transport/bytes.hpp"
@@ -33,7 +34,11 @@ class Session {
   // reachable (peer not yet connected or declared) the request is re-sent every 20 ms, so
   // this also waits for a peer that is starting. Throws TimeoutError if no reply came within
   // `timeout`, RemoteError if the peer replied with an error, TransportError otherwise.
-  Bytes request(const std::string& key, ByteView payload, std::chrono::milliseconds timeout) const;
+  // With `accept`, only a reply it takes counts; others (e.g. without the run's authentication
+  // tag, from a foreign replier on the key) are skipped while the real one may still come.
+  using Accept = std::function<bool(ByteView reply)>;
+  Bytes request(const std::string& key, ByteView payload, std::chrono::milliseconds timeout,
+                const Accept& accept = {}) const;
 
   // Single attempt: like request() but throws NoReplyError at once if no queryable answered.
   Bytes request_once(const std::string& key, ByteView payload,
