@@ -39,6 +39,7 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
   msg::Sequence sequence;
   msg::StepState state;
   bool coupler_seen = false;
+  long refused = 0;
   auto last_heard = Clock::now();
   for (;;) {
     auto q = queryable.recv(std::chrono::milliseconds(200));
@@ -64,13 +65,15 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
       continue;
     }
     // A request without the run's tag comes from a process that cannot read the run's key file:
-    // it is not answered (an answer, even an Error, would be a message sealed with our key) and
-    // does not count as the coupler being heard.
+    // it gets a transport-level error, never a message sealed with our key, and does not count as
+    // the coupler being heard. The log names the first refusals, then every 1000th (a flood of
+    // forged requests must not fill the disk).
     std::span<const std::uint8_t> bytes;
     try {
       bytes = o.key->unseal(q->payload());
     } catch (const msg::ProtocolError& e) {
-      LOG_WARN("request on " << q->key() << " refused: " << e.what());
+      if (++refused <= 10 || refused % 1000 == 0)
+        LOG_WARN("request on " << q->key() << " refused (" << refused << " so far): " << e.what());
       q->reply_error("not authenticated");
       continue;
     }
