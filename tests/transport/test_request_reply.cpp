@@ -108,6 +108,27 @@ TEST(TransportRequestReply, ManualRecvAndReplyExposeKey) {
   t.join();
 }
 
+// A filtered request takes the reply its callback accepts even when another replier on the key
+// answers first (the coupler's defence against a foreign peer); without an acceptable reply it
+// times out, and an error reply from the foreign peer does not pre-empt the real one.
+TEST(TransportRequestReply, AcceptSkipsRefusedRepliesFromOtherRepliers) {
+  tt::TempDir dir;
+  const std::string key = tt::unique_prefix("acc") + "/solid/solve";
+  auto [server, client] = tt::linked_sessions(dir.unix_endpoint());
+  auto foreign_session = at::Session::open({.listen = {}, .connect = {dir.unix_endpoint()}});
+  auto real = server.declare_queryable(key);
+  auto foreign = foreign_session.declare_queryable(key);
+  BackgroundServer fast(foreign, [](const at::IncomingQuery&) -> at::Bytes { throw std::runtime_error("garbage"); });
+  BackgroundServer slow(real, [](const at::IncomingQuery&) {
+    std::this_thread::sleep_for(200ms);  // the foreign error reply arrives first
+    return at::Bytes{'g', 'o', 'o', 'd'};
+  });
+  const auto good = [](at::ByteView b) { return at::to_string(b) == "good"; };
+  EXPECT_EQ(at::to_string(client.request(key, at::as_bytes("q"), 20s, good)), "good");
+  const auto nothing = [](at::ByteView) { return false; };
+  EXPECT_THROW(client.request(key, at::as_bytes("q"), 1s, nothing), at::TransportError);
+}
+
 TEST(TransportSession, ListenOnBusyEndpointFails) {
   tt::TempDir dir;
   auto first = at::Session::open({.listen = {dir.unix_endpoint()}, .connect = {}});

@@ -25,9 +25,6 @@ std::string timeout_message(const std::string& key, milliseconds timeout, bool r
          ")";
 }
 
-// One az_request call waiting at most `wait`: the reply, or nullopt when the request finished
-// without any (no queryable reachable). Throws TimeoutError naming the caller's `timeout` when
-// the queryable did not answer in time, RemoteError / TransportError on failures.
 // The C callback in front of Session::Accept: exceptions must not cross into Rust.
 int accept_trampoline(void* ctx, const std::uint8_t* data, std::size_t len) {
   try {
@@ -37,6 +34,9 @@ int accept_trampoline(void* ctx, const std::uint8_t* data, std::size_t len) {
   }
 }
 
+// One az_request call waiting at most `wait`: the reply, or nullopt when the request finished
+// without any (no queryable reachable). Throws TimeoutError naming the caller's `timeout` when
+// the queryable did not answer in time, RemoteError / TransportError on failures.
 std::optional<Bytes> attempt(az_session* s, const std::string& key, ByteView payload, milliseconds wait,
                              milliseconds timeout, const Session::Accept& accept = {}) {
   az_bytes raw{nullptr, 0};

@@ -147,8 +147,8 @@ pub type az_accept_fn = Option<unsafe extern "C" fn(*mut c_void, *const u8, usiz
 
 /// Sends `data` to the queryable(s) on `keyexpr` and waits up to `timeout_ms` for the first
 /// reply that `accept` takes (any reply when it is NULL). Refused replies, and error replies while
-/// a callback filters, are skipped: a foreign replier on the key cannot pre-empt the real one. AZ_OK: `*out_reply` holds it (free with az_bytes_free). AZ_TIMEOUT: nothing within the
-/// timeout. AZ_NO_REPLY: the query completed with no reply (typically: no matching queryable
+/// a callback filters, are skipped: a foreign replier on the key cannot pre-empt the real one.
+/// AZ_OK: `*out_reply` holds it (free with az_bytes_free). AZ_TIMEOUT: nothing within the timeout. AZ_NO_REPLY: the query completed with no reply (typically: no matching queryable
 /// reachable right now). AZ_ERR_REPLY: the replier sent an error (message in az_last_error).
 #[no_mangle]
 pub unsafe extern "C" fn az_request(
