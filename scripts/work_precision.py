@@ -4,12 +4,12 @@ each discretization knob and reports, per knob and output, the error against the
 ladder (or its Richardson extrapolation when three runs show a clean convergence order).
 
   scripts/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,beam]
-                            [--tol 0.01] [--out-dir DIR] [--build-dir DIR]
+                            [--tol 0.01] [--out-dir DIR] [--build-dir DIR] [--reuse JSON ...]
 
 Knobs (each ladder holds the scene's own setting, "shipped"; the others are kept as shipped):
   steps         time.steps x 1/4, 1/2, 1, 2, 4 (fixed steps: `time.adaptive` is switched off)
   coupling_tol  coupling.rel_tol 1e-2, 3e-3, 1e-3, 3e-4, 1e-4
-  newton_tol    solid.newton.rtol 1e-4, 1e-6, 1e-8, 1e-10
+  newton_tol    solid.newton.rtol 1e-4, 1e-6, 1e-8, 1e-10, atol scaled alike (its ratio to rtol kept)
   mesh          balloon/artery divisions x 1, 1.5, 2 per direction (tube generators; a patient
                 artery: patient.mesh.size / 1, 1.5, 2)
   beam          stent.generator.elements_per_strut (and per connector) 2, 3, 4, 6
@@ -64,7 +64,14 @@ def _set_coupling_tol(s, v):
 
 
 def _set_newton_tol(s, v):
-    s.setdefault("solid", {}).setdefault("newton", {})["rtol"] = v
+    # The solid Newton stops at |r| <= atol or |r| <= rtol |r0| (solid_solver model.cpp), so rtol
+    # alone does not move a scene whose atol is the looser criterion (the straight scene: rtol
+    # 1e-4 ... 1e-10 gave identical results). Both are scaled together, atol keeping its ratio to
+    # rtol in the scene (1e-4 / 1e-8 by default).
+    nw = s.setdefault("solid", {}).setdefault("newton", {})
+    ratio = nw.get("atol", 1e-4) / nw.get("rtol", 1e-8)
+    nw["rtol"] = v
+    nw["atol"] = v * ratio
 
 
 def _set_mesh(s, f):
@@ -96,7 +103,7 @@ def knobs(scene, quick):
         "steps": (_steps_levels(quick), _set_steps, 1.0, "load steps x", 2.0),
         "coupling_tol": ([1e-2, 1e-3, 1e-4] if quick else [1e-2, 3e-3, 1e-3, 3e-4, 1e-4], _set_coupling_tol,
                          c.get("rel_tol", 1e-3), "coupling rel_tol", None),
-        "newton_tol": ([1e-4, 1e-6, 1e-8, 1e-10], _set_newton_tol, nw.get("rtol", 1e-8), "solid Newton rtol", 100.0),
+        "newton_tol": ([1e-4, 1e-6, 1e-8, 1e-10], _set_newton_tol, nw.get("rtol", 1e-8), "solid Newton rtol (atol alike)", 100.0),
         "mesh": ([1.0, 1.5, 2.0], _set_mesh, 1.0, "mesh refinement x", None),
         "beam": ([2, 3] if quick else [2, 3, 4, 6], _set_beam, g.get("elements_per_strut", 3),
                  "beam elements per strut", None),
@@ -255,6 +262,10 @@ def main():
     ap.add_argument("--tol", type=float, default=0.01, help="relative error a setting must keep (default 1 %%)")
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "work_precision"))
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--reuse", action="append", default=[], metavar="JSON",
+                    help="take the runs of an earlier work_precision.json instead of running them again "
+                         "(matched by the variant scene's hash; repeatable), e.g. to draw ladders run "
+                         "separately in one diagram")
     a = ap.parse_args()
     if not (a.tol > 0 and math.isfinite(a.tol)):
         print(f"work_precision: --tol: expected a positive number, got {a.tol}", file=sys.stderr)
@@ -276,6 +287,15 @@ def main():
             return 2
     os.makedirs(a.out_dir, exist_ok=True)
     cache = {}
+    for path in a.reuse:
+        try:
+            earlier = json.load(open(path))
+            for kr in earlier["knobs"].values():
+                for r in kr["runs"]:
+                    cache[r["run"]] = {k: r[k] for k in ("run", "status", "wall_s", "outputs")}
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            print(f"work_precision: --reuse {path}: expected a work_precision.json, got {e}", file=sys.stderr)
+            return 2
     knob_runs = {}
     for k in chosen:
         levels, apply, shipped, label, ratio = all_knobs[k]
