@@ -3,7 +3,8 @@
 expansion: every run of the quick ladders (load steps x 1/2, 1, 2; coupling rel_tol 1e-2, 1e-3,
 1e-4; beam elements per strut 2, 3) finishes, the JSON/CSV/PNG are written, the finest run of a
 ladder without a Richardson reference has zero error, and tightening the coupling tolerance brings
-the stent diameter closer to the reference (convergence in the coupling tolerance).
+the stent diameter closer to the reference (convergence in the coupling tolerance); --reuse of the
+JSON reproduces every run without running it again.
 Usage: test_work_precision_quick.py BIN_DIR
 """
 import json
@@ -47,5 +48,16 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
     # strict: the loose tolerance must move the diameter at all (measured 6.8e-5 against 1.2e-7)
     check(e[0] > 0 and e[0] > e[1], f"tighter coupling tolerance, smaller diameter error ({e[0]:.2e} > {e[1]:.2e})")
     check("verdict" in r.stdout, "a verdict is printed")
+    # --reuse: the same ladders from the first invocation's JSON, without running anything again
+    out2 = tmp / "out2"
+    r2 = subprocess.run(["/usr/bin/python3", str(ROOT / "scripts" / "work_precision.py"), str(scene), "--quick",
+                         "--out-dir", str(out2), "--reuse", str(out / "work_precision.json")],
+                        capture_output=True, text=True, timeout=120)
+    check(r2.returncode == 0 and not list(out2.glob("run-*")), f"--reuse runs nothing again (rc {r2.returncode})")
+    if r2.returncode == 0:
+        doc2 = json.load(open(out2 / "work_precision.json"))
+        same = all(a["outputs"] == b["outputs"] for k in doc["knobs"]
+                   for a, b in zip(doc["knobs"][k]["runs"], doc2["knobs"][k]["runs"]))
+        check(same, "--reuse gives the same outputs per run")
 
 finish()
