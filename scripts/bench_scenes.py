@@ -28,7 +28,7 @@ import time
 
 import yaml
 
-from scene_variant import launch_command, variant_scene
+from scene_variant import launch_command, resolve_scene, variant_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
@@ -46,10 +46,7 @@ def coupled_scenes():
 
 
 def resolve(scene):
-    for cand in (scene, os.path.join(ROOT, "configs", scene), os.path.join(ROOT, "configs", scene + ".yaml")):
-        if os.path.isfile(cand):
-            return os.path.abspath(cand)
-    sys.exit(f"bench_scenes: no scene '{scene}' (a path or a name in configs/)")
+    return resolve_scene(scene) or sys.exit(f"bench_scenes: no scene '{scene}' (a path or a name in configs/)")
 
 
 def alone_scene(scene):

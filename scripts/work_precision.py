@@ -41,7 +41,7 @@ import time
 
 import yaml
 
-from scene_variant import launch_command, variant_scene
+from scene_variant import launch_command, resolve_scene, variant_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
@@ -270,9 +270,8 @@ def main():
     if not (a.tol > 0 and math.isfinite(a.tol)):
         print(f"work_precision: --tol: expected a positive number, got {a.tol}", file=sys.stderr)
         return 2
-    cands = [a.scene, os.path.join(ROOT, "configs", a.scene), os.path.join(ROOT, "configs", a.scene + ".yaml")]
-    base_path = os.path.abspath(next((c for c in cands if os.path.isfile(c)), a.scene))
-    if not os.path.isfile(base_path):
+    base_path = resolve_scene(a.scene)
+    if base_path is None:
         print(f"work_precision: {a.scene}: no such scene", file=sys.stderr)
         return 2
     base = yaml.safe_load(open(base_path))
