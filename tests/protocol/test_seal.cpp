@@ -49,7 +49,7 @@ TEST(Seal, RoundTripAndEveryAlterationIsRefused) {
     auto bad = sealed;
     bad[i] ^= 0x01;
     EXPECT_THROW(k.unseal(bad), msg::ProtocolError) << "byte " << i;
-    EXPECT_FALSE(k.authentic(bad));
+    EXPECT_FALSE(k.verified(bad));
   }
 }
 
@@ -72,7 +72,7 @@ TEST(Seal, AnotherKeyOrNoTagIsRefused) {
   EXPECT_THROW(key_of(1).unseal(env), msg::ProtocolError);  // an unsealed envelope: its tail is no tag
   EXPECT_THROW(key_of(1).unseal(std::vector<std::uint8_t>(msg::RunKey::kTagBytes, 0)), msg::ProtocolError);
   EXPECT_THROW(key_of(1).unseal({}), msg::ProtocolError);
-  EXPECT_TRUE(key_of(1).authentic(key_of(1).seal(env)));
+  EXPECT_TRUE(key_of(1).verified(key_of(1).seal(env)));
 }
 
 TEST(Seal, KeyFileIsReadWhenOwnerOnly) {

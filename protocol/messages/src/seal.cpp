@@ -84,24 +84,24 @@ std::vector<std::uint8_t> RunKey::seal(std::span<const std::uint8_t> envelope) c
   return out;
 }
 
-std::span<const std::uint8_t> RunKey::unseal(std::span<const std::uint8_t> sealed) const {
-  if (sealed.size() <= kTagBytes)
-    throw ProtocolError("message of " + std::to_string(sealed.size()) + " bytes is too short to carry an authentication tag");
+std::optional<std::span<const std::uint8_t>> RunKey::verified(std::span<const std::uint8_t> sealed) const noexcept {
+  if (sealed.size() <= kTagBytes) return std::nullopt;
   const auto envelope = sealed.first(sealed.size() - kTagBytes);
-  const auto tag = tag_(envelope);
-  if (CRYPTO_memcmp(tag.data(), sealed.data() + envelope.size(), kTagBytes) != 0)  // constant time
-    throw ProtocolError("message is not authenticated by the run's key (a process without the run's key file, "
-                        "or altered on the way)");
+  try {
+    const auto tag = tag_(envelope);
+    if (CRYPTO_memcmp(tag.data(), sealed.data() + envelope.size(), kTagBytes) != 0) return std::nullopt;  // constant time
+  } catch (...) {  // HMAC failure (allocation): not verified
+    return std::nullopt;
+  }
   return envelope;
 }
 
-bool RunKey::authentic(std::span<const std::uint8_t> sealed) const noexcept {
-  try {
-    unseal(sealed);
-    return true;
-  } catch (...) {
-    return false;
-  }
+std::span<const std::uint8_t> RunKey::unseal(std::span<const std::uint8_t> sealed) const {
+  if (sealed.size() <= kTagBytes)
+    throw ProtocolError("message of " + std::to_string(sealed.size()) + " bytes is too short to carry an authentication tag");
+  if (const auto envelope = verified(sealed)) return *envelope;
+  throw ProtocolError("message is not authenticated by the run's key (a process without the run's key file, "
+                      "or altered on the way)");
 }
 
 }  // namespace angio::msg

@@ -38,17 +38,15 @@ msg::Buffer Channel::call(const Build& build) {
   // Replies without the run's tag (a foreign replier on the key, or a participant started with
   // another key file) are skipped, counted and named if no authentic reply comes.
   int refused = 0;
+  msg::Buffer reply;  // the envelope of the reply taken, copied out while the filter checks it
   const auto authentic = [&](transport::ByteView bytes) {
-    const bool ok = key_.authentic(bytes);
-    refused += ok ? 0 : 1;
-    return ok;
+    const auto envelope = key_.verified(bytes);
+    if (envelope) reply.assign(envelope->begin(), envelope->end());
+    refused += envelope ? 0 : 1;
+    return envelope.has_value();
   };
-  msg::Buffer reply;
   try {
-    const msg::Buffer sealed = session_.request(keys::request(run_id_, role_name_, verb), key_.seal(request),
-                                                timeout_, authentic);
-    const auto envelope = key_.unseal(sealed);
-    reply.assign(envelope.begin(), envelope.end());
+    session_.request(keys::request(run_id_, role_name_, verb), key_.seal(request), timeout_, authentic);
   } catch (const transport::RemoteError& e) {
     // our role servers answer only one request with a transport-level error: one they could not
     // authenticate (and no foreign replier's error is taken while ours may still come)

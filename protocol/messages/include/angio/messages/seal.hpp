@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -42,8 +43,9 @@ class RunKey {
   // The envelope inside `sealed`; throws ProtocolError when the tag is missing or does not match
   // (a message from a process without the run's key, or altered on the way).
   std::span<const std::uint8_t> unseal(std::span<const std::uint8_t> sealed) const;
-  // Whether `sealed` carries a valid tag (the filter for replies, transport::Session::Accept).
-  bool authentic(std::span<const std::uint8_t> sealed) const noexcept;
+  // The envelope inside `sealed` if its tag is valid, else nullopt (the filter for replies,
+  // transport::Session::Accept, which then keeps the envelope: each reply is checked once).
+  std::optional<std::span<const std::uint8_t>> verified(std::span<const std::uint8_t> sealed) const noexcept;
 
  private:
   std::array<std::uint8_t, kTagBytes> tag_(std::span<const std::uint8_t> envelope) const;
