@@ -4,7 +4,8 @@ each discretization knob and reports, per knob and output, the error against the
 ladder (or its Richardson extrapolation when three runs show a clean convergence order).
 
   scripts/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,beam]
-                            [--tol 0.01] [--out-dir DIR] [--build-dir DIR] [--reuse JSON ...]
+                            [--levels KNOB=V1,V2 ...] [--tol 0.01] [--out-dir DIR] [--build-dir DIR]
+                            [--reuse JSON|RUN_DIR ...]
 
 Knobs (each ladder holds the scene's own setting, "shipped"; the others are kept as shipped):
   steps         time.steps x 1/4, 1/2, 1, 2, 4 (fixed steps: `time.adaptive` is switched off)
@@ -147,9 +148,13 @@ def outputs_of(run_dir):
     return {k: v for k, v in out.items() if isinstance(v, (int, float)) and math.isfinite(v)}
 
 
+def scene_key(scene):
+    """The identity of a variant: a hash of its canonical YAML (names its run directory, matches --reuse)."""
+    return hashlib.sha1(yaml.safe_dump(scene, sort_keys=True).encode()).hexdigest()[:12]
+
+
 def run_scene(base_path, scene, out_dir, build_dir, cache):
-    text = yaml.safe_dump(scene, sort_keys=True)
-    key = hashlib.sha1(text.encode()).hexdigest()[:12]
+    key = scene_key(scene)
     if key in cache:
         return cache[key]
     run_dir = os.path.join(out_dir, f"run-{key}")
@@ -163,6 +168,18 @@ def run_scene(base_path, scene, out_dir, build_dir, cache):
          "outputs": outputs_of(run_dir) if rc == 0 else {}}
     cache[key] = r
     return r
+
+
+def reused_run_dir(path):
+    """A run made by launch.py as a ladder run: its input scene identifies the variant, its wall time is
+    the coupled run's (coupling_summary.json; without the launcher's few seconds before and after)."""
+    # the user's scene: scene.input.yaml where the launcher completed it (a patient), else scene.yaml
+    given = os.path.join(path, "scene.input.yaml")
+    scene = yaml.safe_load(open(given if os.path.isfile(given) else os.path.join(path, "scene.yaml")))
+    summary = json.load(open(os.path.join(path, "coupling_summary.json")))
+    ok = summary["status"] == "ok"
+    return {"run": scene_key(scene), "status": "ok" if ok else summary["status"], "wall_s": float(summary["wall_time"]),
+            "outputs": outputs_of(path) if ok else {}}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -262,10 +279,13 @@ def main():
     ap.add_argument("--tol", type=float, default=0.01, help="relative error a setting must keep (default 1 %%)")
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "work_precision"))
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
-    ap.add_argument("--reuse", action="append", default=[], metavar="JSON",
-                    help="take the runs of an earlier work_precision.json instead of running them again "
-                         "(matched by the variant scene's hash; repeatable), e.g. to draw ladders run "
-                         "separately in one diagram")
+    ap.add_argument("--reuse", action="append", default=[], metavar="JSON|RUN_DIR",
+                    help="take the runs of an earlier work_precision.json, or a run directory of launch.py, "
+                         "instead of running them again (matched by the variant scene's hash; repeatable), "
+                         "e.g. to draw ladders run separately in one diagram or to use a long run made before")
+    ap.add_argument("--levels", action="append", default=[], metavar="KNOB=V1,V2",
+                    help="run these settings of a knob instead of its ladder (the shipped one is always "
+                         "included; repeatable), e.g. coupling_tol=1e-2 for a scene whose runs take an hour")
     a = ap.parse_args()
     if not (a.tol > 0 and math.isfinite(a.tol)):
         print(f"work_precision: --tol: expected a positive number, got {a.tol}", file=sys.stderr)
@@ -284,17 +304,37 @@ def main():
         if k not in all_knobs:
             print(f"work_precision: --knobs: unknown knob '{k}', expected some of {','.join(all_knobs)}", file=sys.stderr)
             return 2
-    os.makedirs(a.out_dir, exist_ok=True)
     cache = {}
     for path in a.reuse:
         try:
+            if os.path.isdir(path):
+                r = reused_run_dir(path)
+                cache[r["run"]] = r
+                continue
             earlier = json.load(open(path))
             for kr in earlier["knobs"].values():
                 for r in kr["runs"]:
                     cache[r["run"]] = {k: r[k] for k in ("run", "status", "wall_s", "outputs")}
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            print(f"work_precision: --reuse {path}: expected a work_precision.json, got {e}", file=sys.stderr)
+        except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
+            print(f"work_precision: --reuse {path}: expected a work_precision.json or a run directory of "
+                  f"launch.py (scene.yaml, coupling_summary.json), got {e}", file=sys.stderr)
             return 2
+    for spec in a.levels:
+        knob, _, values = spec.partition("=")
+        if knob not in chosen:
+            print(f"work_precision: --levels {spec}: '{knob}' is not among the knobs run "
+                  f"({','.join(chosen)}; see --knobs)", file=sys.stderr)
+            return 2
+        try:
+            levels = [int(v) if knob == "beam" else float(v) for v in values.split(",")]
+        except ValueError:
+            levels = []
+        if not levels or not all(math.isfinite(v) and v > 0 for v in levels):
+            print(f"work_precision: --levels {spec}: expected {knob}=V1[,V2...] with positive "
+                  f"{'integers' if knob == 'beam' else 'numbers'}", file=sys.stderr)
+            return 2
+        all_knobs[knob] = (levels,) + all_knobs[knob][1:]
+    os.makedirs(a.out_dir, exist_ok=True)
     knob_runs = {}
     for k in chosen:
         levels, apply, shipped, label, ratio = all_knobs[k]

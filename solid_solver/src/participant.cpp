@@ -80,6 +80,13 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
                             for (const auto& b : model_->mesh().blocks) s += " " + b.name;
                             return s;
                           }());
+    const double atol = scene_.options.newton.atol;
+    LOG_INFO("solid: peak pressure load " << scene_.peak_load_norm << " N (reference mesh), Newton atol " << atol
+                                          << " N = " << atol / scene_.peak_load_norm << " of it");
+    if (scene_.peak_load_norm > 0.0 && atol > kWarnAtolOfLoad * scene_.peak_load_norm)
+      LOG_WARN("solid.newton.atol = " << atol << " N is more than " << kWarnAtolOfLoad
+                                      << " of the peak pressure load (" << scene_.peak_load_norm
+                                      << " N): the equilibrium error it accepts may show in the results");
   }
 }
 

@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <limits>
 #include <set>
+#include <sstream>
 
 #include "angio/geometry/centerline_scene.hpp"
+#include "angio/solid/load_scale.hpp"
 
 namespace angio::solid {
 
@@ -403,6 +405,28 @@ SolidScene read_solid_scene(const Node& root) {
       if (no.modified && no.reuse_preconditioner > 0)
         n->child("reuse_preconditioner").fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
     }
+  }
+  // The Newton stops at ||r|| <= atol whatever the load; an atol of the order of the loads' own norm
+  // accepts a loaded step before anything moves (found by the Newton-tolerance ladder of issue 17:
+  // atol 1 N on the straight scene, the balloon never inflated and the run ended "ok").
+  std::vector<std::pair<std::string, double>> peaks;
+  for (const auto& p : sc.pressures) {
+    double c = 0.0;
+    for (const auto& [t, v] : p.curve.points()) c = std::max(c, std::abs(v));
+    peaks.emplace_back(p.surface, p.value * c);
+  }
+  sc.peak_load_norm = pressure_load_norm(sc.mesh, peaks);
+  const double atol = sc.options.newton.atol;
+  if (sc.peak_load_norm > 0.0 && atol >= kMaxAtolOfLoad * sc.peak_load_norm) {
+    std::ostringstream m;
+    m << "an absolute residual tolerance well below the norm of the peak pressure load (" << sc.peak_load_norm
+      << " N on the reference mesh): at most " << kMaxAtolOfLoad * sc.peak_load_norm
+      << " N, the shipped scenes use about 1e-4 of it; a tolerance this loose accepts a loaded step before it moves";
+    const auto s = root.optional("solid");
+    const auto n = s ? s->optional("newton") : std::nullopt;
+    if (n && n->has("atol")) n->child("atol").fail(m.str());
+    m << " (solid.newton.atol is not given: its default " << atol << " N)";
+    root.fail(m.str());
   }
   return sc;
 }

@@ -4,7 +4,8 @@ expansion: every run of the quick ladders (load steps x 1/2, 1, 2; coupling rel_
 1e-4; beam elements per strut 2, 3) finishes, the JSON/CSV/PNG are written, the finest run of a
 ladder without a Richardson reference has zero error, and tightening the coupling tolerance brings
 the stent diameter closer to the reference (convergence in the coupling tolerance); --reuse of the
-JSON reproduces every run without running it again.
+JSON reproduces every run without running it again; --reuse of a run directory with --levels takes
+the shipped run from that directory.
 Usage: test_work_precision_quick.py BIN_DIR
 """
 import json
@@ -59,5 +60,24 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
         same = all(a["outputs"] == b["outputs"] for k in doc["knobs"]
                    for a, b in zip(doc["knobs"][k]["runs"], doc2["knobs"][k]["runs"]))
         check(same, "--reuse gives the same outputs per run")
+    # --reuse of a run directory (a long run made by launch.py) and --levels: the shipped run taken
+    # from its directory (wall time from its coupling_summary.json), the 1e-2 run from the JSON
+    shipped = next(r for r in doc["knobs"]["coupling_tol"]["runs"] if r["shipped"])
+    run_dir = out / f"run-{shipped['run']}"
+    out3 = tmp / "out3"
+    r3 = subprocess.run(["/usr/bin/python3", str(ROOT / "scripts" / "work_precision.py"), str(scene),
+                         "--knobs", "coupling_tol", "--levels", "coupling_tol=1e-2", "--out-dir", str(out3),
+                         "--reuse", str(out / "work_precision.json"), "--reuse", str(run_dir)],
+                        capture_output=True, text=True, timeout=120)
+    check(r3.returncode == 0 and not list(out3.glob("run-*")),
+          f"--levels with --reuse of a run directory runs nothing again (rc {r3.returncode}) {r3.stderr[-300:]}")
+    if r3.returncode == 0:
+        runs3 = json.load(open(out3 / "work_precision.json"))["knobs"]["coupling_tol"]["runs"]
+        wall = json.load(open(run_dir / "coupling_summary.json"))["wall_time"]
+        check(sorted(r["level"] for r in runs3) == [1e-3, 1e-2], f"--levels: 1e-2 and the shipped 1e-3 "
+              f"({[r['level'] for r in runs3]})")
+        s3 = next(r for r in runs3 if r["shipped"])
+        check(s3["wall_s"] == wall and s3["outputs"] == shipped["outputs"],
+              "the shipped run is the run directory's (its wall time, the same outputs)")
 
 finish()

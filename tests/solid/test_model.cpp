@@ -11,6 +11,8 @@
 #include <numbers>
 #include <type_traits>
 
+#include <unistd.h>
+
 #include "angio/scene/node.hpp"
 #include "angio/solid/model.hpp"
 #include "angio/solid/participant.hpp"
@@ -565,4 +567,39 @@ TEST(Scene, ErrorsNameTheKey) {
   } catch (const angio::scene::SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("artery.layers.media.E"), std::string::npos) << e.what();
   }
+}
+
+// solid.newton.atol is judged against the norm of the peak pressure load (load_scale.hpp): at
+// kMaxAtolOfLoad of it the scene is refused naming the key, just below it is accepted. Consistency
+// with the scene's own load norm (the straight scene's Newton ladder, issue 17: atol ~ the load norm
+// accepted every step at iteration 0 and the balloon never inflated).
+TEST(Scene, AbsoluteToleranceOfTheOrderOfTheLoadIsRefused) {
+  const std::string shipped = std::string(ANGIO_CONFIGS_DIR) + "/solid_free_balloon.yaml";
+  std::ifstream in(shipped);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "atol: 1.0e-9";
+  ASSERT_NE(text.find(key), std::string::npos);
+  const double F = read_solid_scene(angio::scene::load_scene(shipped)).peak_load_norm;
+  ASSERT_GT(F, 0.0);
+  auto with_atol = [&](double atol) {
+    std::string t = text;
+    t.replace(t.find(key), key.size(), "atol: " + std::to_string(atol));
+    const std::string path = std::filesystem::temp_directory_path() /
+                             ("angio_atol_" + std::to_string(getpid()) + "_" + std::to_string(world_rank()) + ".yaml");
+    std::ofstream(path) << t;
+    return path;
+  };
+  const std::string loose = with_atol(1.01 * kMaxAtolOfLoad * F);
+  try {
+    read_solid_scene(angio::scene::load_scene(loose));
+    FAIL() << "expected SceneError for atol " << 1.01 * kMaxAtolOfLoad * F << " N against a load of " << F << " N";
+  } catch (const angio::scene::SceneError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("solid.newton.atol"), std::string::npos) << w;
+    EXPECT_NE(w.find("peak pressure load"), std::string::npos) << w;
+  }
+  const std::string fine = with_atol(0.99 * kMaxAtolOfLoad * F);
+  EXPECT_NO_THROW(read_solid_scene(angio::scene::load_scene(fine)));
+  std::filesystem::remove(loose);
+  std::filesystem::remove(fine);
 }

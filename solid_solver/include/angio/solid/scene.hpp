@@ -40,6 +40,11 @@ struct DiameterSpec {
   }
 };
 
+// solid.newton.atol must stay below this fraction of peak_load_norm (a scene error otherwise).
+inline constexpr double kMaxAtolOfLoad = 0.1;
+// Above this fraction the solver warns (see README "Error against run time", Newton-tolerance ladder).
+inline constexpr double kWarnAtolOfLoad = 1e-3;
+
 struct SolidScene {
   Mesh mesh;
   std::vector<LayerMaterial> materials;  // per mesh block
@@ -55,6 +60,9 @@ struct SolidScene {
   double apposition_threshold = 0.1;  // mm
   bool has_balloon = false, has_artery = false;
   int ranks = 0;  // solid.ranks (0: not given)
+  // Norm of the nodal force vector of all pressures at their curves' peaks, reference mesh (N): the
+  // scale solid.newton.atol is checked against (load_scale.hpp).
+  double peak_load_norm = 0.0;
   int output_every = 1;
   scene::TimeSettings time;
 };
