@@ -527,6 +527,13 @@ def main(run_dir):
                           " / ".join(f"{st[k]:.1f}" if num(st.get(k)) is not None else "inf"
                                      for k in ("axis_radius_initial", "axis_radius_at_max_diameter",
                                                "axis_radius_final")), None)]
+                halves = [st.get(k) for k in ("axis_radius_halves_initial", "axis_radius_halves_at_max_diameter",
+                                              "axis_radius_halves_final")]
+                if all(isinstance(h, list) and len(h) == 2 for h in halves):  # >= 5 rings (beam summary)
+                    for i in (0, 1):
+                        rows.append((f"axis radius of half {i} crimped / max / final (mm)",
+                                     " / ".join(f"{h[i]:.1f}" if num(h[i]) is not None else "inf" for h in halves),
+                                     None))
     if solid:
         out["solid"] = {k: v for k, v in solid.items() if k != "steps"}
         for k, v in solid.items():

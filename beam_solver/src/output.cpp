@@ -253,12 +253,17 @@ std::string write_summary(const std::string& path, const BeamModel& m,
         {"axis_radius_initial", finite(initial.axis_radius)},
         {"axis_radius_at_max_diameter", finite(pk.axis_radius)},
         {"axis_radius_final", finite(fin.axis_radius)},
+        {"axis_radius_halves_initial", {finite(initial.axis_radius_half[0]), finite(initial.axis_radius_half[1])}},
+        {"axis_radius_halves_at_max_diameter", {finite(pk.axis_radius_half[0]), finite(pk.axis_radius_half[1])}},
+        {"axis_radius_halves_final", {finite(fin.axis_radius_half[0]), finite(fin.axis_radius_half[1])}},
         {"definitions",
          "D_distal: outer crowns of the end rings, D_central: crowns of the middle ring(s); "
          "dogboning = (D_distal - D_central)/D_distal; foreshortening = (L0 - L)/L0, L = extent of the nodes along "
          "the deformed axis (through the ring centroids); "
          "axis sagitta: distance of the middle crowns' centroid from the chord through the centroids of the end "
-         "rings' outer crowns, axis radius: radius of the circle through the three (null: straight)"}};
+         "rings' outer crowns, axis radius: radius of the circle through the three (null: straight); "
+         "axis radius of the halves: the circles through the centroids of the end, quarter and middle rings "
+         "(null: straight or fewer than 5 rings)"}};
   }
   int total_it = 0;
   double total_wall = 0;
@@ -284,6 +289,8 @@ std::string write_summary(const std::string& path, const BeamModel& m,
       e["central_diameter"] = finite(s.central_diameter);
       e["length"] = finite(s.length);
       e["axis_sagitta"] = finite(s.axis_sagitta);
+      e["axis_radius"] = finite(s.axis_radius);
+      e["axis_radius_halves"] = {finite(s.axis_radius_half[0]), finite(s.axis_radius_half[1])};
     }
     e["wall_seconds"] = finite(s.wall_seconds);
     j["steps"].push_back(std::move(e));

@@ -54,6 +54,8 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   const AxisBow b = stent_axis_bow(distal, distal_s, central);
   r.axis_sagitta = b.sagitta;
   r.axis_radius = b.radius;
+  const auto halves = stent_half_bows(scene_.stent->ring_crowns, x);
+  for (int h = 0; h < 2; ++h) r.axis_radius_half[h] = halves[h].radius;
 }
 
 participant::SamplePoints BeamSolverParticipant::sample_points() const {

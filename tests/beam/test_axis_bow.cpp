@@ -56,3 +56,43 @@ TEST(AxisBow, GeneratedStentOnAnArc) {
     }
   }
 }
+
+// The halves' bows (stent_half_bows). Analytic: on the arc of radius 15 mm every ring centroid lies
+// on the arc (inside it by ≈ 0.02 mm, as above), so both halves have radius 15 mm (2 %); a straight
+// stent has straight halves; a straight stent kinked at its middle ring (rings beyond it rotated
+// by 0.3 rad about the middle ring's centroid) has straight halves while the whole-device bow
+// through ends and middle reads a finite radius, the case the halves are there to tell apart.
+TEST(AxisBow, HalvesOfAStent) {
+  const double R = 15.0;
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= 400; ++i) {
+    const double a = 24.0 / R * i / 400;
+    pts.emplace_back(R * (1 - std::cos(a)), 0.0, R * std::sin(a));
+  }
+  StentParameters p;
+  p.rings = 11;
+  const StentMesh arc = generate_corrugated_rings(p, pts);
+  ASSERT_EQ(arc.ring_crowns.size(), 11u);
+  for (const AxisBow& h : stent_half_bows(arc.ring_crowns, arc.nodes)) EXPECT_NEAR(h.radius, R, 0.02 * R);
+
+  const StentMesh straight = generate_corrugated_rings(p);
+  for (const AxisBow& h : stent_half_bows(straight.ring_crowns, straight.nodes)) EXPECT_TRUE(std::isinf(h.radius));
+
+  std::vector<Vec3> x = straight.nodes;
+  auto centroid = [&](int k) {
+    Vec3 c = Vec3::Zero();
+    for (int n : straight.ring_crowns[k]) c += x[n];
+    return Vec3(c / double(straight.ring_crowns[k].size()));
+  };
+  const Vec3 pivot = centroid(5);
+  const Eigen::Matrix3d rot = Eigen::AngleAxisd(0.3, Vec3::UnitY()).toRotationMatrix();
+  for (int k = 6; k < 11; ++k)
+    for (int n : straight.ring_crowns[k]) x[n] = pivot + rot * (straight.nodes[n] - pivot);
+  const auto halves = stent_half_bows(straight.ring_crowns, x);
+  EXPECT_GT(halves[0].radius, 1e6);
+  EXPECT_GT(halves[1].radius, 1e6);
+  EXPECT_LT(axis_bow(centroid(0), pivot, centroid(10)).radius, 100.0);  // 16.5 mm kinked by 0.3 rad: ≈ 28 mm
+
+  std::vector<std::vector<int>> four(straight.ring_crowns.begin(), straight.ring_crowns.begin() + 4);
+  EXPECT_TRUE(std::isnan(stent_half_bows(four, straight.nodes)[0].radius));
+}

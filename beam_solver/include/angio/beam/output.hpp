@@ -51,6 +51,8 @@ struct StepRecord {
   // crowns (axis_bow.hpp)
   double axis_sagitta = std::numeric_limits<double>::quiet_NaN();
   double axis_radius = std::numeric_limits<double>::quiet_NaN();
+  // radius of each half's bow (stent_half_bows: end ring, quarter ring, middle ring)
+  double axis_radius_half[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 // Writes summary.json (nlohmann::json, indent 2; non-finite numbers as null); returns the text
