@@ -29,6 +29,9 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   s.max_iterations = static_cast<int>(c->integer_or("max_iterations", s.max_iterations, 1));
   s.rel_tol = c->non_negative_or("rel_tol", s.rel_tol);
   s.abs_tol = c->non_negative_or("abs_tol", s.abs_tol);
+  // rel_tol 1 accepts a residual as large as the contact loads themselves: every first iteration
+  // passes and the coupling does nothing (the solid's atol has the like check against its loads)
+  if (!(s.rel_tol < 1.0)) c->child("rel_tol").fail("a relative tolerance below 1 (typically 1e-3)");
   if (s.rel_tol == 0.0 && s.abs_tol == 0.0)
     c->fail("a positive coupling.rel_tol or coupling.abs_tol (both are 0: nothing can converge)");
   s.strict = c->boolean_or("strict", s.strict);

@@ -2,7 +2,8 @@
 """Bad input in the generic artery scene's keys is refused through the launcher: exit code 2 and a
 message naming the file and the key path (README "Scenes"). One case per new key of the artery
 procedure: viscous tau <= 0, beta < 0, apposition threshold < 0, a layer without a material,
-an unknown key in the viscous branch, too many lumen stations.
+an unknown key in the viscous branch, too many lumen stations; a solid Newton atol of the order of
+the peak pressure load and a coupling rel_tol of 1 (tolerances that pass a step before it moves).
 No run directory is created (the launcher asks the executables with --check first).
 Usage: test_generic_artery_bad_input.py BIN_DIR
 """
@@ -31,6 +32,9 @@ CASES = [
     ("lumen stations huge", lambda s: s["artery"].update(summary={"lumen_stations": 10 ** 9}),
      "artery.summary.lumen_stations"),
     ("layer without material", lambda s: s["artery"]["layers"].pop("adventitia"), "artery.layers"),
+    # tolerances that accept a step before it moves (the Newton ladder's atol 1 N ended "ok" uninflated)
+    ("solid atol of the order of the load", lambda s: s["solid"]["newton"].update(atol=1.0), "solid.newton.atol"),
+    ("coupling rel_tol 1", lambda s: s["coupling"].update(rel_tol=1.0), "coupling.rel_tol"),
 ]
 
 with tempfile.TemporaryDirectory() as tmp:
