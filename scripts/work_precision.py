@@ -199,7 +199,8 @@ def richardson(values, ratio):
 
 def analyse(knob_runs, tol):
     """Errors per run and output, the reference used, and the verdict."""
-    verdict = {"dominant_at_shipped": None, "cheapest_within_tol": {}, "shipped_errors": {}, "orders": {}}
+    verdict = {"dominant_at_shipped": None, "cheapest_within_tol": {}, "shipped_errors": {}, "orders": {},
+               "not_estimated": {}}
     worst = (0.0, None)
     for knob, k in knob_runs.items():
         runs = [r for r in k["runs"] if r["status"] == "ok"]
@@ -218,13 +219,23 @@ def analyse(knob_runs, tol):
                     r.setdefault("errors", {})[name] = abs(v - ref) / abs(ref)
                     r.setdefault("reference", {})[name] = "richardson" if q_ext is not None else "finest"
         shipped = [r for r in runs if r["shipped"]]
-        if shipped:
+        # the shipped run as its own reference (finest of the ladder, no Richardson value): its
+        # error is unknown, not zero; what is known is how far the next coarser level lies from it
+        own_ref = bool(shipped) and shipped[0] is runs[-1] and all(
+            v == "finest" for v in shipped[0].get("reference", {}).values())
+        if own_ref:
+            coarser = runs[-2] if len(runs) > 1 else None
+            verdict["not_estimated"][knob] = {
+                "next_coarser_level": coarser["level"] if coarser else None,
+                "its_difference": max(coarser.get("errors", {}).values(), default=0.0) if coarser else None}
+        elif shipped:
             e = shipped[0].get("errors", {})
             verdict["shipped_errors"][knob] = e
             m = max(e.values(), default=0.0)
             if m > worst[0]:
                 worst = (m, knob)
-        ok = [r for r in runs if r.get("errors") and max(r["errors"].values()) <= tol]
+        ok = [r for r in runs if r.get("errors") and max(r["errors"].values()) <= tol
+              and not (own_ref and r is runs[-1])]
         if ok:
             best = min(ok, key=lambda r: r["wall_s"])
             verdict["cheapest_within_tol"][knob] = {"level": best["level"], "wall_s": best["wall_s"]}
@@ -373,15 +384,14 @@ def main():
             print(f"  {k:<13}{str(r['level']):>8}{'*' if r['shipped'] else ' '} {r['status']:<8}{r['wall_s']:>8.1f} s"
                   f"   worst error {worst[1]:.2e} ({worst[0]})")
     dom = verdict["dominant_at_shipped"]
-    print(f"verdict: at the shipped settings the largest error comes from '{dom}'"
+    print(f"verdict: at the shipped settings the largest estimated error comes from '{dom}'"
           f" ({max(verdict['shipped_errors'].get(dom, {}).values(), default=0):.2e})" if dom else
-          "verdict: no knob changes the outputs measurably at the shipped settings")
-    for k, kr in knob_runs.items():
-        ok = [r for r in kr["runs"] if r["status"] == "ok"]
-        if ok and all(not is_finer(k, r["level"], next(x["level"] for x in ok if x["shipped"])) for r in ok
-                      if any(x["shipped"] for x in ok)):
-            print(f"  {k}: the shipped setting is the finest of this ladder, its own error is not estimated "
-                  f"(the full ladder, without --quick, has finer levels)")
+          "verdict: no knob with an estimated error changes the outputs measurably at the shipped settings")
+    for k, ne in verdict["not_estimated"].items():
+        diff = (f"; the next coarser level ({ne['next_coarser_level']}) differs from it by up to "
+                f"{ne['its_difference']:.2e}" if ne["next_coarser_level"] is not None else "")
+        print(f"  {k}: the shipped setting is the finest of this ladder, its own error is not estimated{diff} "
+              f"(add finer levels: --levels, or the full ladder without --quick)")
     for k, c in verdict["cheapest_within_tol"].items():
         print(f"  cheapest {k} keeping every output within {100 * a.tol:g} %: {c['level']} ({c['wall_s']:.1f} s)")
     for k, o in verdict["orders"].items():
