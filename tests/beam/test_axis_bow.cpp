@@ -9,6 +9,18 @@
 
 using namespace angio::beam;
 
+namespace {
+// A planar circular arc of radius R, 24 mm long, in the x–z plane (401 points).
+std::vector<Vec3> arc_points(double R) {
+  std::vector<Vec3> pts;
+  for (int i = 0; i <= 400; ++i) {
+    const double a = 24.0 / R * i / 400;
+    pts.emplace_back(R * (1 - std::cos(a)), 0.0, R * std::sin(a));
+  }
+  return pts;
+}
+}  // namespace
+
 // Analytic: three points on a circle of radius R at angles −θ, 0, θ have chord 2R sin θ, sagitta
 // R(1 − cos θ) and circumradius R; collinear points are straight (infinite radius, zero sagitta).
 TEST(AxisBow, PointsOnACircle) {
@@ -30,11 +42,7 @@ TEST(AxisBow, PointsOnACircle) {
 // arc, which raises the radius by ≈ 0.9 % (tolerance 2 %). The straight stent has no bow.
 TEST(AxisBow, GeneratedStentOnAnArc) {
   const double R = 15.0;
-  std::vector<Vec3> pts;
-  for (int i = 0; i <= 400; ++i) {
-    const double a = 24.0 / R * i / 400;
-    pts.emplace_back(R * (1 - std::cos(a)), 0.0, R * std::sin(a));
-  }
+  const std::vector<Vec3> pts = arc_points(R);
   StentParameters p;
   p.rings = 11;
   const angio::geometry::Centerline axis(pts);
@@ -64,11 +72,7 @@ TEST(AxisBow, GeneratedStentOnAnArc) {
 // through ends and middle reads a finite radius, the case the halves are there to tell apart.
 TEST(AxisBow, HalvesOfAStent) {
   const double R = 15.0;
-  std::vector<Vec3> pts;
-  for (int i = 0; i <= 400; ++i) {
-    const double a = 24.0 / R * i / 400;
-    pts.emplace_back(R * (1 - std::cos(a)), 0.0, R * std::sin(a));
-  }
+  const std::vector<Vec3> pts = arc_points(R);
   StentParameters p;
   p.rings = 11;
   const StentMesh arc = generate_corrugated_rings(p, pts);
