@@ -1,9 +1,11 @@
 """Scene variants for the scripts that derive a scene from a shipped one (bench_scenes.py,
-stability.py, work_precision.py): the variant is written next to its base while it runs, so that
-the base's relative paths (e.g. `centerlines/...`) resolve as they do for the base, and it is
-launched through scripts/launch.py like any scene (the launcher sets one BLAS thread per process).
-Scene names resolve the same way in all of them (resolve_scene)."""
+stability.py, work_precision.py, sensitivity.py): the variant is written next to its base while it
+runs, so that the base's relative paths (e.g. `centerlines/...`) resolve as they do for the base,
+and it is launched through scripts/launch.py like any scene (the launcher sets one BLAS thread per
+process). Scene names resolve the same way in all of them (resolve_scene); changes given as dotted
+key paths are applied the same way in all of them (apply_set)."""
 import contextlib
+import copy
 import os
 import shutil
 import sys
@@ -27,6 +29,29 @@ def variant_scene(base_path, scene, tag, header, keep=None):
         if keep:
             shutil.copy(path, keep)
         os.remove(path)
+
+
+class SetError(ValueError):
+    """A change that does not fit the base scene; the message names where it was given and the key."""
+
+
+def apply_set(scene, changes, where):
+    """Applies `changes` ({dotted.key.path: value}) to `scene` in place: each value replaces the
+    base's (a map or list included, as a whole); the maps on the way must exist in the base, so a
+    misspelt section is an error instead of a new key. `where` (e.g. "case.yaml: set") starts the
+    message of the SetError raised otherwise."""
+    if not isinstance(changes, dict):
+        raise SetError(f"{where}: expected a map of dotted key paths to values, got {type(changes).__name__}")
+    for key, value in changes.items():
+        if not isinstance(key, str) or not all(key.split(".")):
+            raise SetError(f"{where}: {key!r}: expected a dotted key path such as artery.mesh.n_circ")
+        node, parts = scene, key.split(".")
+        for p in parts[:-1]:
+            if not isinstance(node.get(p), dict):
+                raise SetError(f"{where}: {key}: the base scene has no map at '{p}'")
+            node = node[p]
+        node[parts[-1]] = copy.deepcopy(value)
+    return scene
 
 
 def resolve_scene(name):

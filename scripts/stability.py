@@ -15,7 +15,6 @@ Either way within `max_wall` seconds (a hang is a failure). Prints one row per c
 any case does not behave as expected. Units: mm, N, MPa, s.
 """
 import argparse
-import copy
 import csv
 import json
 import math
@@ -29,7 +28,7 @@ import time
 
 import yaml
 
-from scene_variant import launch_command, variant_scene
+from scene_variant import SetError, apply_set, launch_command, variant_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CASE_KEYS = {"base", "expect", "set", "max_wall"}
@@ -56,13 +55,10 @@ def compose(case, case_path):
     """The base scene with the case's changes applied (dotted key paths)."""
     base_path = os.path.normpath(os.path.join(os.path.dirname(case_path), case["base"]))
     scene = yaml.safe_load(open(base_path))
-    for key, value in (case.get("set") or {}).items():
-        node, parts = scene, key.split(".")
-        for p in parts[:-1]:
-            if not isinstance(node.get(p), dict):
-                fail(f"{case_path}: set: {key}: the base scene has no map at '{p}'")
-            node = node[p]
-        node[parts[-1]] = copy.deepcopy(value)
+    try:
+        apply_set(scene, case.get("set") or {}, f"{case_path}: set")
+    except SetError as e:
+        fail(str(e))
     return base_path, scene
 
 

@@ -38,19 +38,13 @@ AxisBow stent_axis_bow(const std::vector<Vec3>& distal, const std::vector<double
   return axis_bow(c[0] / count[0], mid / double(central.size()), c[1] / count[1]);
 }
 
-std::array<AxisBow, 2> stent_half_bows(const std::vector<std::vector<int>>& ring_crowns, const std::vector<Vec3>& x) {
+std::array<AxisBow, 2> stent_half_bows(const std::vector<Vec3>& c) {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-  const int n = int(ring_crowns.size());
+  const int n = int(c.size());
   if (n < 5) return {AxisBow{nan, nan, nan}, AxisBow{nan, nan, nan}};
-  auto centroid = [&](int k) {
-    if (ring_crowns[k].empty()) throw std::invalid_argument("stent_half_bows: a ring without crowns");
-    Vec3 c = Vec3::Zero();
-    for (int node : ring_crowns[k]) c += x.at(node);
-    return Vec3(c / double(ring_crowns[k].size()));
-  };
-  const Vec3 mid = 0.5 * (centroid((n - 1) / 2) + centroid(n / 2));
+  const Vec3 mid = 0.5 * (c[(n - 1) / 2] + c[n / 2]);
   const int q = (n - 1) / 4;
-  return {axis_bow(centroid(0), centroid(q), mid), axis_bow(mid, centroid(n - 1 - q), centroid(n - 1))};
+  return {axis_bow(c[0], c[q], mid), axis_bow(mid, c[n - 1 - q], c[n - 1])};
 }
 
 }  // namespace angio::beam

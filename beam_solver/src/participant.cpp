@@ -37,7 +37,8 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   if (!scene_.stent) return;
   // diameters about the axis of the deformed stent (ring_axis.hpp), the reference axis for one ring
   const std::vector<Vec3>& x = m.positions(reference);
-  const Axis axis = ring_centroid_axis(scene_.stent->ring_crowns, x).value_or(m.axis);
+  const std::optional<Axis> rings = ring_centroid_axis(scene_.stent->ring_crowns, x);
+  const Axis axis = rings.value_or(m.axis);
   r.diameter = mean_diameter(axis, x);
   r.distal_diameter = mean_diameter(axis, x, scene_.stent->distal_nodes);
   r.central_diameter = mean_diameter(axis, x, scene_.stent->central_nodes);
@@ -54,8 +55,10 @@ void BeamSolverParticipant::stent_measures(StepRecord& r, bool reference) const 
   const AxisBow b = stent_axis_bow(distal, distal_s, central);
   r.axis_sagitta = b.sagitta;
   r.axis_radius = b.radius;
-  const auto halves = stent_half_bows(scene_.stent->ring_crowns, x);
-  for (int h = 0; h < 2; ++h) r.axis_radius_half[h] = halves[h].radius;
+  if (rings) {  // the halves' bows from the same ring centroids
+    const auto halves = stent_half_bows(rings->points);
+    for (int h = 0; h < 2; ++h) r.axis_radius_half[h] = halves[h].radius;
+  }
 }
 
 participant::SamplePoints BeamSolverParticipant::sample_points() const {

@@ -192,15 +192,14 @@ bool element_internal_fixed(const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud
     const double detF = F.determinant();
     if (!(detF > 0.0)) ok = false;
     const Mat3 C = F.transpose() * F;
-    stress_tangent(mat, fibers, C, S, K ? &D : nullptr);
     if (visc) {  // S = S∞ + Q (eq. B.8), Q from eq. B.7 integrated over the step
-      const Vec6 s_inf = to_voigt_stress(S);
-      double factor = 1.0;
-      const Vec6 Q = viscous_update(visc->branch, visc->dt, visc->Q_n[q], visc->S_n[q], s_inf, &factor);
+      Vec6 Q, Sv;
+      viscous_stress_tangent(mat, fibers, visc->branch, visc->dt, visc->Q_n[q], visc->S_n[q], C, S,
+                             K ? &D : nullptr, Q, Sv);
       if (visc->Q_out) visc->Q_out[q] = Q;
-      if (visc->S_out) visc->S_out[q] = s_inf;
-      S += from_voigt_stress(Q);
-      if (K) D *= factor;
+      if (visc->S_out) visc->S_out[q] = Sv;
+    } else {
+      stress_tangent(mat, fibers, C, S, K ? &D : nullptr);
     }
     const double dV = detJ0 * rule[q].w;
     for (int a = 0; a < NN; ++a)
@@ -223,7 +222,8 @@ bool element_internal_fixed(const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud
           for (int i = 0; i < 3; ++i) Ke(3 * a + i, 3 * b + i) += GSG(a, b);
     }
     if (out) {
-      out->cauchy_avg += F * S * F.transpose() / detF;
+      out->cauchy_qp[q] = F * S * F.transpose() / detF;
+      out->cauchy_avg += out->cauchy_qp[q];
       out->energy += energy(mat, fibers, C) * dV;
       out->volume += dV;
     }

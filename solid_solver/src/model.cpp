@@ -673,10 +673,12 @@ void SolidModel::rollback() {
   pc_current_ = false;  // a rejected step restarts from a fresh factorization
 }
 
-void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume) const {
+void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume,
+                                std::vector<Mat3>* gauss) const {
   p1.resize(local_elements_.size());
   dir.resize(local_elements_.size());
   if (volume) volume->resize(local_elements_.size());
+  if (gauss) gauss->clear();
   Eigen::MatrixXd X, u;
   Eigen::VectorXd fe;
   for (size_t i = 0; i < local_elements_.size(); ++i) {
@@ -691,6 +693,7 @@ void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir
     p1[i] = eig.eigenvalues()(2);
     dir[i] = eig.eigenvectors().col(2);
     if (volume) (*volume)[i] = es.volume;
+    if (gauss) gauss->insert(gauss->end(), es.cauchy_qp.begin(), es.cauchy_qp.begin() + volume_rule(el.type).size());
   }
 }
 

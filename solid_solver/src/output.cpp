@@ -1,6 +1,7 @@
 #include "angio/solid/output.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -177,8 +178,23 @@ void FieldWriter::close() {
   }
 }
 
+std::vector<std::string> nodal_stress_field_names(const Mesh& mesh) {
+  std::vector<std::string> names;
+  for (const auto& b : mesh.blocks) {
+    std::string n = "stress_p1_nodal_" + b.name;
+    for (auto& c : n)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) c = '_';
+    names.push_back(n);
+  }
+  std::vector<std::string> out = names;
+  for (size_t b = 0; b < names.size(); ++b)
+    if (std::count(names.begin(), names.end(), names[b]) > 1) out[b].append("_").append(std::to_string(b));
+  return out;
+}
+
 void FieldWriter::write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir,
-                             const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal) {
+                             const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal,
+                             const std::vector<std::pair<std::string, const std::vector<double>*>>& owned_nodal) {
   const std::string g = "/steps/" + std::to_string(step);
   const long n0 = model_.owned_node_begin(), n1 = model_.owned_node_end(), N = long(model_.mesh().X.size());
   std::vector<double> u(3 * (n1 - n0));
@@ -192,6 +208,13 @@ void FieldWriter::write_step(int step, double time, const std::vector<double>& p
     std::vector<double> v(n1 - n0);
     for (long i = n0; i < n1; ++i) v[i - n0] = (*values)[model_.old_index(int(i))];
     write_rows(file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, v.data());
+    info.nodal.push_back(field);
+  }
+  for (const auto& [field, values] : owned_nodal) {
+    if (long(values->size()) != n1 - n0)
+      throw std::invalid_argument("write_step: owned nodal field " + field + " has " + std::to_string(values->size()) +
+                                  " values for " + std::to_string(n1 - n0) + " owned nodes");
+    write_rows(file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, values->data());
     info.nodal.push_back(field);
   }
   for (const auto& ti : types_) {

@@ -66,6 +66,8 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     lumen_ = LumenProfile(nodes, st, scene_.lumen_max_stations);
     endothelium_area_ = nodal_areas(mesh, *endo);
   }
+  recovery_ = std::make_unique<StressRecovery>(*model_);
+  nodal_stress_names_ = nodal_stress_field_names(model_->mesh());
   time_ = scene_.time.start;
   model_->start_at(time_);
   if (!run_dir.empty()) {
@@ -80,10 +82,11 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
                             for (const auto& b : model_->mesh().blocks) s += " " + b.name;
                             return s;
                           }());
-    const double atol = scene_.options.newton.atol;
-    LOG_INFO("solid: peak pressure load " << scene_.peak_load_norm << " N (reference mesh), Newton atol " << atol
-                                          << " N = " << atol / scene_.peak_load_norm << " of it");
-    if (scene_.peak_load_norm > 0.0 && atol > kWarnAtolOfLoad * scene_.peak_load_norm)
+    const double atol = scene_.options.newton.atol, F = scene_.peak_load_norm;
+    if (F > 0.0)  // no pressure load (a scene loaded by displacements only): nothing to judge atol by
+      LOG_INFO("solid: peak pressure load " << F << " N (reference mesh), Newton atol " << atol << " N = " << atol / F
+                                            << " of it");
+    if (F > 0.0 && atol > kWarnAtolOfLoad * F)
       LOG_WARN("solid.newton.atol = " << atol << " N is more than " << kWarnAtolOfLoad
                                       << " of the peak pressure load (" << scene_.peak_load_norm
                                       << " N): the equilibrium error it accepts may show in the results");
@@ -223,6 +226,48 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
   for (size_t b = 0; b < nb; ++b) s.stress[b].p99 = weighted_quantile(values[b], weights[b], 0.99);
 }
 
+void SolidRunner::nodal_stress_(StepSummary& s) const {
+  // every owned (node, block) of the recovery as (block, p1, weight, on the lumen, current x y z),
+  // gathered on rank 0 (as the element values in block_stress_)
+  const StressRecovery& rec = *recovery_;
+  const int nb = rec.num_blocks(), n0 = model_->owned_node_begin();
+  std::vector<double> mine;
+  for (int i = 0; i < rec.num_owned(); ++i) {
+    const int node = model_->old_index(n0 + i);
+    const double lumen = !endothelium_area_.empty() && endothelium_area_[node] > 0.0 ? 1.0 : 0.0;
+    const Vec3d x = model_->position(node);
+    for (int b = 0; b < nb; ++b)
+      if (rec.has(i, b)) mine.insert(mine.end(), {double(b), rec.p1(i, b), rec.weight(i, b), lumen, x(0), x(1), x(2)});
+  }
+  int size = 1;
+  MPI_Comm_size(comm_, &size);
+  const int count = int(mine.size());
+  std::vector<int> counts(size), displs(size, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
+  std::vector<double> all;
+  if (rank_ == 0) {
+    for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+    all.resize(displs.back() + counts.back());
+  }
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm_);
+  if (rank_ != 0) return;
+  std::vector<std::vector<double>> values(nb), weights(nb);
+  for (size_t k = 0; k + 6 < all.size(); k += 7) {
+    const int b = int(all[k]);
+    const double v = all[k + 1];
+    BlockStress& bs = s.stress[b];
+    values[b].push_back(v);
+    weights[b].push_back(all[k + 2]);
+    if (!(v <= bs.max_nodal)) {  // also the first (max_nodal NaN)
+      bs.max_nodal = v;
+      bs.where_nodal = Vec3d(all[k + 4], all[k + 5], all[k + 6]);
+    }
+    if (all[k + 3] > 0.0 && !(v <= bs.max_endothelium_nodal)) bs.max_endothelium_nodal = v;
+  }
+  for (int b = 0; b < nb; ++b)
+    if (!values[b].empty()) s.stress[b].p99_nodal = weighted_quantile(values[b], weights[b], 0.99);
+}
+
 void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_pressure) {
   const auto& mesh = model_->mesh();
   std::vector<Vec3d> x(mesh.X.size());
@@ -288,12 +333,21 @@ void SolidRunner::write_apposition_csv_(const std::vector<double>& gap, const st
 void SolidRunner::record_and_write_(int step, double time) {
   std::vector<double> p1, vol;
   std::vector<Vec3d> dir;
-  model_->element_stress(p1, dir, &vol);
+  std::vector<Mat3> gauss;
+  model_->element_stress(p1, dir, &vol, &gauss);
   StepSummary s;
   s.step = step;
   s.time = time;
   for (const auto& p : scene_.pressures) s.pressures.emplace_back(p.label, p.value * p.curve.value(time));
   block_stress_(p1, vol, s);
+  const bool recovered = recovery_->recover(gauss);
+  recovery_seconds_ += recovery_->last_seconds();
+  if (!recovered && rank_ == 0 && !warned_recovery_) {
+    LOG_WARN("solid: the nodal stress recovery (CG on the mass matrix) did not converge at step "
+             << step << "; its values are those of the last iterate");
+    warned_recovery_ = true;
+  }
+  nodal_stress_(s);
   // the maxima on every rank (the log line and the history of the followers)
   const size_t nb = model_->mesh().blocks.size();
   std::vector<double> local(nb, -std::numeric_limits<double>::max());
@@ -316,7 +370,13 @@ void SolidRunner::record_and_write_(int step, double time) {
   if (writer_ && (step % scene_.output_every == 0 || step == 0)) {
     std::vector<std::pair<std::string, const std::vector<double>*>> nodal;
     if (!contact_pressure.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);
-    writer_->write_step(step, time, p1, dir, nodal);
+    std::vector<std::vector<double>> fields(recovery_->num_blocks());
+    std::vector<std::pair<std::string, const std::vector<double>*>> owned;
+    for (int b = 0; b < recovery_->num_blocks(); ++b) {
+      fields[b] = recovery_->p1_field(b);
+      owned.emplace_back(nodal_stress_names_[b], &fields[b]);
+    }
+    writer_->write_step(step, time, p1, dir, nodal, owned);
   }
   if (writer_ && rank_ == 0) write_summary_json_();
 }
@@ -330,6 +390,12 @@ void SolidRunner::write_summary_json_() const {
   j["stress_measure"] =
       "first principal Cauchy stress of the Gauss-point averaged element stress: max over the elements of a block "
       "(with the current centroid of that element) and the 99th percentile by reference volume";
+  j["stress_measure_nodal"] =
+      "first principal Cauchy stress of the recovered nodal tensor: L2 projection (consistent mass, reference "
+      "configuration) of the Gauss-point Cauchy tensor onto the nodes of each block separately, so a node on a layer "
+      "interface has one value per layer (solid.h5 fields stress_p1_nodal_<block>); per block the max over its nodes "
+      "(with the current position of that node), the 99th percentile (nodes weighted by their share V_e/n_e of the "
+      "block's reference volume) and the max over its nodes on the lumen surface (endothelium; blocks that touch it)";
   j["blocks"] = ordered_json::array();
   for (size_t b = 0; b < mesh.blocks.size(); ++b)
     j["blocks"].push_back({{"id", b}, {"name", mesh.blocks[b].name}, {"part", mesh.blocks[b].part}});
@@ -365,6 +431,7 @@ void SolidRunner::write_summary_json_() const {
                    {"contact_seconds", t.contact_seconds},
                    {"linear_seconds", t.linear_seconds},
                    {"solve_seconds", t.total_seconds},
+                   {"stress_recovery_seconds", recovery_seconds_},
                    {"note", "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest"}};
   }
   j["steps"] = ordered_json::array();
@@ -385,6 +452,19 @@ void SolidRunner::write_summary_json_() const {
     e["max_principal_stress"] = mx;
     e["p99_principal_stress"] = p99;
     e["max_principal_stress_at"] = where;
+    ordered_json mxn, p99n, wheren, endo;
+    for (size_t b = 0; b < s.stress.size(); ++b) {
+      const auto& bs = s.stress[b];
+      const std::string& name = mesh.blocks[b].name;
+      mxn[name] = finite(bs.max_nodal);
+      p99n[name] = finite(bs.p99_nodal);
+      wheren[name] = {bs.where_nodal(0), bs.where_nodal(1), bs.where_nodal(2)};
+      if (std::isfinite(bs.max_endothelium_nodal)) endo[name] = bs.max_endothelium_nodal;
+    }
+    e["max_principal_stress_nodal"] = mxn;
+    e["p99_principal_stress_nodal"] = p99n;
+    e["max_principal_stress_nodal_at"] = wheren;
+    if (!endo.is_null()) e["max_principal_stress_endothelium_nodal"] = endo;
     for (const auto& [part, u] : s.max_displacement) e["max_displacement"][part] = u;
     if (scene_.balloon_diameter) {
       const double dog = s.d_mid > 0 ? (0.5 * (s.d_end0 + s.d_end1) - s.d_mid) / s.d_mid : 0.0;

@@ -24,10 +24,14 @@ LayerMaterial read_material(const Node& n, const std::string& name) {
   m.matrix.nu = n.number_or("nu", 0.0);
   if (!(m.matrix.nu >= 0.0 && m.matrix.nu < 0.5)) n.child("nu").fail("a Poisson's ratio in [0, 0.5)");
   if (auto v = n.optional("viscous")) {  // paper eqs. B.5–B.8: Q' + Q/tau = beta S'
-    v->check_keys({"tau", "beta"});
+    v->check_keys({"tau", "beta", "acts_on"});
     ViscousBranch vb;
     vb.tau = v->positive("tau");
     vb.beta = v->non_negative("beta");
+    // which part of S∞ relaxes: the Neo-Hooke matrix (4C's VISCO_GenMax, the default) or all of it
+    vb.acts_on = v->choice_or("acts_on", {"isotropic", "all"}, to_string(kViscousActsOnDefault)) == "isotropic"
+                     ? ViscousActsOn::isotropic
+                     : ViscousActsOn::all;
     m.viscous = vb;
   }
   if (auto f = n.optional("fibers")) {

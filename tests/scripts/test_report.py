@@ -53,6 +53,11 @@ MEDIA_MAX = [0.0, 0.0021, 0.0024, 2.5, 8.1, 1.2, 0.19]          # MPa
 MEDIA_P99 = [0.0, 0.0018, 0.0020, 1.1, 3.3, 0.6, 0.09]
 ADV_MAX = [0.0, 0.00015, 0.00016, 0.02, 0.051, 0.03, 0.014]
 ADV_P99 = [0.0, 0.0001, 0.00012, 0.01, 0.03, 0.02, None]         # null as the solid writes it
+# recovered nodal values (*_nodal keys): above the element ones, the media's peak on the lumen surface
+MEDIA_MAX_NODAL = [0.0, 0.0030, 0.0033, 4.0, 12.5, 2.0, 0.31]
+MEDIA_P99_NODAL = [0.0, 0.0025, 0.0028, 1.6, 4.4, 0.8, 0.12]
+MEDIA_ENDO_NODAL = [0.0, 0.0030, 0.0033, 4.0, 12.0, 1.9, 0.30]
+ADV_MAX_NODAL = [0.0, 0.0002, 0.00021, 0.025, 0.06, 0.035, 0.016]
 U_ARTERY = [0.0, 0.12, 0.13, 0.2, 0.3, 0.28, 0.27]
 STENT_D = [1.15, 1.15, 1.16, 1.6, 2.14, 2.16, 1.90]               # beam max (2.16) is not at the peak
 STATIONS = [-5.5 + i for i in range(12)]                           # mm, stent spans -3 .. 3
@@ -80,6 +85,13 @@ def make_artery_run(run):
              "max_principal_stress": {"balloon": 1.0 + i, "media": MEDIA_MAX[i], "adventitia": ADV_MAX[i]},
              "p99_principal_stress": {"balloon": 0.5, "media": MEDIA_P99[i], "adventitia": ADV_P99[i]},
              "max_principal_stress_at": {"balloon": [0, 0, 3], "media": [0.8, 0, 3], "adventitia": [1.1, 0, 3]},
+             "max_principal_stress_nodal": {"balloon": 2.0 + i, "media": MEDIA_MAX_NODAL[i],
+                                            "adventitia": ADV_MAX_NODAL[i]},
+             "p99_principal_stress_nodal": {"balloon": 0.6, "media": MEDIA_P99_NODAL[i], "adventitia": None},
+             "max_principal_stress_nodal_at": {"balloon": [0, 0, 3], "media": [0.79, 0, 3],
+                                               "adventitia": [1.1, 0, 3]},
+             # only the layer that touches the lumen
+             "max_principal_stress_endothelium_nodal": {"media": MEDIA_ENDO_NODAL[i]},
              "max_displacement": {"balloon": 0.5 * i, "artery": U_ARTERY[i]},
              "balloon_outer_diameter": {"mid": 1.0, "end0": 1.1, "end1": 1.1, "dogboning": 0.01 * i}}
         prof = LUMEN.get(i, [1.62 + 0.05 * i] * 12)
@@ -219,6 +231,32 @@ class ArteryReport(unittest.TestCase):
         self.assertAlmostEqual(self.ours("contact force balloon -> artery at peak (N)"), 2 * 1.317, places=3)
         self.assertAlmostEqual(self.ours("  balloon pressure at peak (atm)"), 1.317 / ATM, places=2)
 
+    def test_nodal_stress_rows(self):
+        # next to the element rows, which stay as they were
+        self.assertAlmostEqual(self.ours("peak: media max principal stress (kPa)"), 8100.0)
+        self.assertAlmostEqual(self.ours("peak: media max principal stress, nodal (kPa)"), 12500.0)
+        self.assertAlmostEqual(self.paper("peak: media max principal stress, nodal (kPa)"), 7990.0)
+        self.assertAlmostEqual(self.ours("peak: media max principal stress, endothelium nodal (kPa)"), 12000.0)
+        # the paper's 7.99 MPa is "at the endothelial surface": the innermost layer's lumen-side nodes
+        self.assertAlmostEqual(self.paper("peak: media max principal stress, endothelium nodal (kPa)"), 7990.0)
+        self.assertAlmostEqual(self.ours("peak: media p99 principal stress, nodal (kPa)"), 4400.0)
+        self.assertAlmostEqual(self.ours("after: adventitia max principal stress, nodal (kPa)"), 16.0)
+        self.assertAlmostEqual(self.paper("after: adventitia max principal stress, nodal (kPa)"), 13.7)
+        self.assertAlmostEqual(self.ours("prestressed: media max principal stress, nodal (kPa)"), 3.3)
+        self.assertNotIn("prestressed: media p99 principal stress, nodal (kPa)", self.rows)  # as the element p99
+        self.assertNotIn("peak: adventitia max principal stress, endothelium nodal (kPa)", self.rows)  # no lumen
+        self.assertNotIn("peak: adventitia p99 principal stress, nodal (kPa)", self.rows)  # null
+        self.assertFalse(any("balloon" in n and "nodal" in n for n in self.rows))  # artery layers only
+        layer = self.res["artery"]["phases"]["peak"]["layers"]["media"]
+        self.assertAlmostEqual(layer["max_principal_stress_nodal"], 12.5)
+        self.assertAlmostEqual(layer["p99_principal_stress_nodal"], 4.4)
+        self.assertEqual(layer["max_principal_stress_nodal_at"], [0.79, 0, 3])
+        self.assertAlmostEqual(layer["max_principal_stress_endothelium_nodal"], 12.0)
+        self.assertAlmostEqual(layer["paper_max_principal_stress_endothelium"], 7.99)
+        adv = self.res["artery"]["phases"]["peak"]["layers"]["adventitia"]
+        self.assertIsNone(adv["max_principal_stress_endothelium_nodal"])
+        self.assertIsNone(adv["paper_max_principal_stress_endothelium"])
+
     def test_lumen_and_apposition(self):
         self.assertAlmostEqual(self.ours("min lumen diameter after, stented (mm)"), 1.85)
         self.assertAlmostEqual(self.ours("min lumen diameter peak, stented (mm)"), 2.10)
@@ -293,7 +331,9 @@ class EmptyRun(unittest.TestCase):
             solid = json.loads((run / "solid" / "summary.json").read_text())
             for s in solid["steps"]:
                 for k in ("lumen_diameter", "lumen_diameter_min", "lumen_diameter_max", "apposition",
-                          "artery_contact_force", "p99_principal_stress"):
+                          "artery_contact_force", "p99_principal_stress", "max_principal_stress_nodal",
+                          "p99_principal_stress_nodal", "max_principal_stress_nodal_at",
+                          "max_principal_stress_endothelium_nodal"):
                     s.pop(k, None)
             solid["steps"] = solid["steps"][:4]
             del solid["lumen_stations"]
@@ -305,7 +345,9 @@ class EmptyRun(unittest.TestCase):
             self.assertNotIn("Traceback", r.stderr)
             raw = (run / "results.json").read_text()
             self.assertNotIn("NaN", raw)
-            self.assertIn("prestressed: media max principal stress (kPa)", table(r.stdout))
+            rows = table(r.stdout)
+            self.assertIn("prestressed: media max principal stress (kPa)", rows)
+            self.assertFalse(any("nodal" in n for n in rows))  # a run before the nodal recovery: no nodal rows
 
 
 if __name__ == "__main__":

@@ -316,22 +316,34 @@ TEST(Model, ModifiedNewtonGivesTheSameSolutionWithFewerFactorizations) {
 
 // Viscous branch (eqs. B.5–B.8) through the model (commit/rollback of the history), consistency
 // properties under a constant follower pressure on the cube: (1) a step of vanishing Δt answers
-// with S = (1 + β) S∞, i.e. exactly the elastic solution of the material with E and k1 scaled by
-// 1 + β; (2) held at that load the cube creeps monotonically and converges to the elastic
+// with S = S∞ + β Sv, i.e. exactly the elastic solution of the material with E scaled by 1 + β
+// (branch on the isotropic Neo-Hooke stress, the default) or E and k1 scaled by 1 + β (acts_on
+// all); (2) held at that load the cube creeps monotonically and converges to the elastic
 // equilibrium of S∞ alone (Q relaxes to 0); (3) a rejected step (rollback) leaves the history
 // untouched: the same step solved again gives the same displacement.
 TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
   const double p = 0.05, beta = 0.3;
   const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
-  auto elastic = [&](double scale) {
-    auto model = pressed_cube(m, LayerMaterial{"cube", {2.0 * scale, 0.3}, {{0.4 * scale, 1.5, 20.0, true}}},
-                              direct_options(), p);
+  auto elastic = [&](double scale_matrix, double scale_fibers) {
+    auto model = pressed_cube(
+        m, LayerMaterial{"cube", {2.0 * scale_matrix, 0.3}, {{0.4 * scale_fibers, 1.5, 20.0, true}}},
+        direct_options(), p);
     EXPECT_TRUE(model->solve().converged);
     return displacements(*model);
   };
-  const auto u_inf = elastic(1.0), u_0 = elastic(1.0 + beta);
+  const auto u_inf = elastic(1.0, 1.0), u_0 = elastic(1.0 + beta, 1.0);
   double scale = 0;
   for (const auto& v : u_inf) scale = std::max(scale, v.norm());
+  {  // acts_on all: instantaneous response of the material with E and k1 scaled by 1 + β
+    LayerMaterial all{"cube", {2.0, 0.3}, {{0.4, 1.5, 20.0, true}}, ViscousBranch{0.5, beta, ViscousActsOn::all}};
+    auto model = pressed_cube(m, all, direct_options(), p);
+    model->start_at(0.0);
+    model->set_time(1e-10);
+    ASSERT_TRUE(model->solve().converged);
+    const auto u_0_all = elastic(1.0 + beta, 1.0 + beta);
+    EXPECT_LT(max_diff(displacements(*model), u_0_all), 1e-8 * scale);
+    EXPECT_GT(max_diff(u_0_all, u_0), 1e-4 * scale);  // the fibers are loaded: the placements differ
+  }
 
   LayerMaterial visc{"cube", {2.0, 0.3}, {{0.4, 1.5, 20.0, true}}, ViscousBranch{0.5, beta}};
   auto model = pressed_cube(m, visc, direct_options(), p);
@@ -566,6 +578,49 @@ TEST(Scene, ErrorsNameTheKey) {
     FAIL() << "expected SceneError";
   } catch (const angio::scene::SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("artery.layers.media.E"), std::string::npos) << e.what();
+  }
+}
+
+// viscous.acts_on: absent → the default (isotropic, 4C's VISCO_GenMax placement), `all` is read,
+// anything else is refused naming the key and the allowed values.
+TEST(Scene, ViscousActsOnIsCheckedAndDefaultsToIsotropic) {
+  const std::string base = std::string(ANGIO_SOLID_TEST_DATA) + "/small_artery.yaml";
+  std::ifstream in(base);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "media: {E: 0.1566, nu: 0.45, ";
+  ASSERT_NE(text.find(key), std::string::npos);
+  auto scene_with = [&](const std::string& viscous) {
+    std::string t = text;
+    t.replace(t.find(key), key.size(), key + "viscous: " + viscous + ", ");
+    const std::string path = std::filesystem::temp_directory_path() /
+                             ("angio_acts_on_" + std::to_string(getpid()) + "_" + std::to_string(world_rank()) + ".yaml");
+    std::ofstream(path) << t;
+    return path;
+  };
+  auto media_branch = [&](const std::string& viscous) {
+    const std::string path = scene_with(viscous);
+    const SolidScene sc = read_solid_scene(angio::scene::load_scene(path));
+    std::filesystem::remove(path);
+    for (const auto& mat : sc.materials)
+      if (mat.name == "media" && mat.viscous) return *mat.viscous;
+    ADD_FAILURE() << "no viscous media in the scene";
+    return ViscousBranch{};
+  };
+  EXPECT_EQ(media_branch("{tau: 0.5, beta: 0.3}").acts_on, ViscousActsOn::isotropic);
+  EXPECT_EQ(media_branch("{tau: 0.5, beta: 0.3, acts_on: isotropic}").acts_on, ViscousActsOn::isotropic);
+  EXPECT_EQ(media_branch("{tau: 0.5, beta: 0.3, acts_on: all}").acts_on, ViscousActsOn::all);
+  for (const std::string bad : {"fibers", "1", "All"}) {
+    const std::string path = scene_with("{tau: 0.5, beta: 0.3, acts_on: " + bad + "}");
+    try {
+      read_solid_scene(angio::scene::load_scene(path));
+      ADD_FAILURE() << "expected SceneError for acts_on: " << bad;
+    } catch (const angio::scene::SceneError& e) {
+      const std::string w = e.what();
+      EXPECT_NE(w.find("artery.layers.media.viscous.acts_on"), std::string::npos) << w;
+      EXPECT_NE(w.find("isotropic"), std::string::npos) << w;
+      EXPECT_NE(w.find("all"), std::string::npos) << w;
+    }
+    std::filesystem::remove(path);
   }
 }
 

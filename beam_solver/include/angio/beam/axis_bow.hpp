@@ -30,12 +30,12 @@ AxisBow axis_bow(const Vec3& end0, const Vec3& middle, const Vec3& end1);
 AxisBow stent_axis_bow(const std::vector<Vec3>& distal, const std::vector<double>& distal_s,
                        const std::vector<Vec3>& central);
 
-// The bow of each half of a generated stent, from the centroids c_k of its rings' crowns
-// (`ring_crowns[k]`, rings in order, x the node positions): half 0 through c_0, c_q, c_mid and
-// half 1 through c_mid, c_(n-1-q), c_(n-1), with q = (n-1)/4 and c_mid the middle ring's centroid
-// (the mean of the two middle rings' for even n). The whole-device bow (stent_axis_bow) cannot tell
-// a device that straightens in its halves but kinks where it is held (the curved free expansion's
-// middle-ring fixation) from one that keeps its curvature; the halves can. NaN below 5 rings.
-std::array<AxisBow, 2> stent_half_bows(const std::vector<std::vector<int>>& ring_crowns, const std::vector<Vec3>& x);
+// The bow of each half of a generated stent from its ring centroids c_k (rings in order: the
+// points of ring_centroid_axis): half 0 through c_0, c_q, c_mid and half 1 through c_mid,
+// c_(n-1-q), c_(n-1), with q = (n-1)/4 and c_mid the middle ring's centroid (the mean of the two
+// middle rings' for even n). The whole-device bow (stent_axis_bow) cannot tell a device that
+// straightens in its halves but kinks where it is held (the curved free expansion's middle-ring
+// fixation) from one that keeps its curvature; the halves can. NaN below 5 rings.
+std::array<AxisBow, 2> stent_half_bows(const std::vector<Vec3>& ring_centroids);
 
 }  // namespace angio::beam

@@ -3,6 +3,7 @@
 // Node orderings follow gmsh (hex8, tet4, tet10: edges 01 12 20 30 32 31; tri6: 01 12 20).
 #pragma once
 #include <Eigen/Dense>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -62,12 +63,16 @@ const std::vector<LocalFace>& local_faces(ElemType t);
 // X, u: n x 3 (reference coordinates and displacements). K may be null (residual only).
 // Returns false if a Jacobian (reference or deformed) is non-positive.
 // visc (optional): the viscous branch of the element's material with its committed Gauss-point
-// history (viscous.hpp); S = S∞ + Q and the tangent scaled by 1 + β g. With visc->Q_out/S_out set
+// history (viscous.hpp); S = S∞ + Q and the tangent dS∞/dE + β g dSv/dE (viscous_stress_tangent;
+// Sv = the isotropic Neo-Hooke stress or all of S∞, ViscousBranch::acts_on). With visc->Q_out/S_out set
 // the updated history is stored there (SolidModel::commit).
 struct ElementStress {
   Mat3 cauchy_avg = Mat3::Zero();  // Gauss-point average of the Cauchy stress
   double energy = 0.0;             // int Psi dV
   double volume = 0.0;             // reference volume
+  // Cauchy stress at each Gauss point, volume_rule(t) order (the first volume_rule(t).size() entries;
+  // stress recovery, recovery_kernels.hpp)
+  std::array<Mat3, 8> cauchy_qp;
 };
 bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixXd& u, const NeoHooke& mat,
                       const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,

@@ -58,10 +58,22 @@ struct FiberSpec {
   bool tension_only = true;
 };
 
+// Part of the hyperelastic stress S∞ that drives the viscous branch (scene `viscous.acts_on`):
+//   isotropic – the Neo-Hooke matrix alone (Ψ_iso, eq. B.2, with its volumetric term); the fiber
+//               stress (eq. B.4) is added after the overstress is formed and never relaxes. This is
+//               4C's placement (MAT_ViscoElastHyper with VISCO_GenMax, src/mat/4C_mat_viscoelasthyper.cpp,
+//               ViscoElastHyper::evaluate: the isotropic summands, then evaluate_visco_gen_max on
+//               that stress, then the anisotropic summands), the code the paper was computed with.
+//   all       – the whole S∞ = S_iso + S_fibers (eqs. B.7–B.8 read literally).
+enum class ViscousActsOn { isotropic, all };
+inline constexpr ViscousActsOn kViscousActsOnDefault = ViscousActsOn::isotropic;  // 4C's placement
+inline const char* to_string(ViscousActsOn a) { return a == ViscousActsOn::isotropic ? "isotropic" : "all"; }
+
 // Parameters of the viscous branch of a layer (paper eqs. B.5–B.8; kernel in viscous.hpp).
 struct ViscousBranch {
   double tau = 0.5;   // relaxation time (s), > 0
   double beta = 0.3;  // ratio of the viscoelastic to the hyperelastic branch, ≥ 0
+  ViscousActsOn acts_on = kViscousActsOnDefault;
 };
 
 // A layer / block material: Neo-Hooke ground matrix plus fiber families, optionally a viscous branch.

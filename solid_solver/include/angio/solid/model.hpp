@@ -173,7 +173,10 @@ class SolidModel {
   // Per local element (order of local_elements()): first principal Cauchy stress (Gauss-point
   // averaged Cauchy tensor) and its unit direction.
   // volume (optional): reference volume of each local element.
-  void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume = nullptr) const;
+  // gauss (optional): the Cauchy tensors at the Gauss points of the local elements, element after
+  // element, volume_rule(type).size() each (the input of StressRecovery::recover).
+  void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume = nullptr,
+                      std::vector<Mat3>* gauss = nullptr) const;
   // Nodal forces that contact model c exerts on the solid at the current state (−its residual
   // contribution), full vector by original node index on every rank. Collective.
   std::vector<Vec3d> contact_forces(ContactModel& c);

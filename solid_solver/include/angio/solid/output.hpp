@@ -18,6 +18,16 @@
 //     /steps/<k>/<type>/stress_p1_dir  [E,3] its unit eigenvector
 //     /steps/<k>/<name>            [N]    extra nodal scalars, e.g. contact_pressure (MPa): |contact
 //                                         force| / lumped nodal area on the endothelium
+//     /steps/<k>/stress_p1_nodal_<layer>  [N]  recovered nodal first principal Cauchy stress (MPa) of
+//                                         block (layer) <layer>, one field per block of the mesh
+//                                         (Mesh::blocks names, characters other than [A-Za-z0-9_-]
+//                                         replaced by '_', "_<block id>" appended to a repeated name):
+//                                         eigenvalue of the L2 projection of the Gauss-point Cauchy
+//                                         tensor onto the nodes of that layer alone (stress_recovery.hpp),
+//                                         so an interface node has one value in each of its layers' fields.
+//                                         NaN at the nodes outside the layer: in ParaView colour the field
+//                                         on that layer's cells (Threshold on block_id); cells of other
+//                                         layers show the NaN colour.
 //   <dir>/solid.xdmf  (rewritten after every step; open in ParaView with the Xdmf3 reader; every
 //                      step's grids carry the static /mesh cell data as attributes too)
 #pragma once
@@ -36,8 +46,11 @@ class FieldWriter {
   ~FieldWriter();
   // Collective. p1/dir: per local element (model.local_elements() order), from element_stress().
   // nodal: extra nodal scalar fields, each a full vector by original node index (same on all ranks).
+  // owned_nodal: nodal scalar fields given for this rank's owned nodes only (new numbering, entry i
+  // for node owned_node_begin() + i), e.g. the recovered stresses (nodal_stress_field_name).
   void write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir,
-                  const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal = {});
+                  const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal = {},
+                  const std::vector<std::pair<std::string, const std::vector<double>*>>& owned_nodal = {});
   void close();
 
  private:
@@ -60,6 +73,11 @@ class FieldWriter {
   };
   std::vector<StepInfo> steps_;
 };
+
+// Names of the recovered nodal stress fields, one per block: "stress_p1_nodal_<block name>" with the
+// name reduced to [A-Za-z0-9_-] (others become '_') and "_<block id>" appended where that makes two
+// names equal.
+std::vector<std::string> nodal_stress_field_names(const Mesh& mesh);
 
 // Creates a directory and its parents (like mkdir -p); throws on failure.
 void make_directories(const std::string& dir);

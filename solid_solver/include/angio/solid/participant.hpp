@@ -6,6 +6,7 @@
 #pragma once
 #include <mpi.h>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "angio/solid/artery_measures.hpp"
 #include "angio/solid/output.hpp"
 #include "angio/solid/scene.hpp"
+#include "angio/solid/stress_recovery.hpp"
 
 namespace angio::solid {
 
@@ -44,6 +46,15 @@ void reset_reply(const participant::SamplePoints& points, participant::ContactRe
 struct BlockStress {
   Vec3d where = Vec3d::Zero();   // current centroid of the element with the maximum
   double p99 = 0.0;              // 99th percentile by reference volume (MPa), robust against one element at a strut
+  // The recovered nodal first principal stress of the block (stress_recovery.hpp: L2 projection onto
+  // the block's own nodes, a layer interface node has one value per layer), rank 0 only; NaN: none.
+  double max_nodal = std::numeric_limits<double>::quiet_NaN();  // max over the block's nodes (MPa)
+  Vec3d where_nodal = Vec3d::Zero();                              // current position of that node
+  // 99th percentile, each node weighted by its share of the block's reference volume (Σ V_e / n_e)
+  double p99_nodal = std::numeric_limits<double>::quiet_NaN();
+  // max over the block's nodes on the lumen surface (scene lumen set, the endothelium); NaN if the
+  // block does not touch the lumen or the scene has none
+  double max_endothelium_nodal = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Per committed step summary (written to <run-dir>/solid/summary.json).
@@ -100,6 +111,10 @@ class SolidRunner : public participant::SolidParticipant {
   std::string dir_;
   std::unique_ptr<SolidModel> model_;
   std::unique_ptr<FieldWriter> writer_;
+  std::unique_ptr<StressRecovery> recovery_;  // recovered nodal stresses per layer
+  std::vector<std::string> nodal_stress_names_;  // their output fields, per block
+  double recovery_seconds_ = 0.0;              // all recover() calls (rank 0), summary.json timing
+  bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
   SolveTotals totals_;  // every solve of the run, rejected steps included
@@ -117,6 +132,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
   void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
   void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
+  void nodal_stress_(StepSummary& s) const;  // from recovery_, into s.stress (rank 0)
   void write_apposition_csv_(const std::vector<double>& gap, const std::vector<double>& weight) const;
 };
 
