@@ -39,7 +39,7 @@ import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 UNIX_PATH_MAX = 107
-# The top-level sections some executable reads (README "Scenes"). The launcher picks the processes
+# The top-level sections some executable reads (docs/user-guide.md "Scenes"). The launcher picks the processes
 # from these keys, so a misspelt one must stop the launch instead of silently running another
 # simulation (a scene without its `stent` runs the balloon alone).
 SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling", "patient")
@@ -286,7 +286,7 @@ def make_run_dir(run_dir, explicit):
 
 
 def write_run_key(path):
-    """A new secret for this launch (README "Security"): every message of the run carries an
+    """A new secret for this launch (docs/reliability.md "Security"): every message of the run carries an
     HMAC-SHA256 tag under it, and the executables read it from <run dir>/run.key, so only processes
     that can read this owner-only file can speak for the coupler or a participant."""
     try:

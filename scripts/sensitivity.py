@@ -3,7 +3,7 @@
 stresses move when one modelling choice changes (end springs, peak pressure, wall split, a contact
 penalty, ...), each change run on its own against the same baseline.
 
-  scripts/sensitivity.py STUDY.yaml [--out-dir DIR] [--build-dir DIR] [--reuse JSON ...] [--only NAME ...]
+  scripts/sensitivity.py STUDY.yaml [--out-dir DIR] [--build-dir DIR] [--reuse JSON|RUN_DIR ...] [--only NAME ...]
 
 A study file (YAML, e.g. configs/studies/generic_artery_sensitivity.yaml) has the keys
   base     the scene, relative to the study file
@@ -23,7 +23,8 @@ name, status, wall time, every output and its difference) and run-<hash>/ per ru
 Markdown table, one row per run. A failed run is a row with its status; the exit code is 1 if any
 run failed, 2 for a bad study file or option (the message names the file and key).
 --reuse JSON: the finished runs of an earlier sensitivity.json whose variant scene is the same (its
-hash) are taken from there instead of run again (failed ones are run again). --only NAME: the
+hash) are taken from there instead of run again (failed ones are run again); --reuse RUN_DIR: a
+finished run directory (e.g. run-<hash>/ of a study that was stopped) serves the same way. --only NAME: the
 baseline and the named changes only. Units: mm, N, MPa, s.
 """
 import argparse
@@ -36,7 +37,7 @@ import sys
 import yaml
 
 from scene_variant import SetError, apply_set
-from work_precision import ROOT, run_scene, scene_key
+from work_precision import ROOT, reused_run_dir, run_scene, scene_key
 
 STUDY_KEYS = ("base", "common", "changes")
 CHANGE_KEYS = ("name", "set")
@@ -120,7 +121,8 @@ def main():
     ap.add_argument("study")
     ap.add_argument("--out-dir")
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
-    ap.add_argument("--reuse", action="append", default=[], metavar="JSON", help="an earlier sensitivity.json (repeatable)")
+    ap.add_argument("--reuse", action="append", default=[], metavar="JSON|RUN_DIR",
+                    help="an earlier sensitivity.json, or a finished run directory (repeatable)")
     ap.add_argument("--only", nargs="+", metavar="NAME", help="run the baseline and these changes only")
     a = ap.parse_args()
     base_path, runs = load_study(a.study)
@@ -131,6 +133,14 @@ def main():
         runs = runs[:1] + [r for r in runs[1:] if r[0] in a.only]
     cache = {}
     for path in a.reuse:
+        if os.path.isdir(path):  # a finished run directory of launch.py (e.g. a run of an earlier study)
+            try:
+                r = reused_run_dir(path)
+            except (OSError, ValueError, KeyError) as e:
+                fail(f"--reuse {path}: expected a run directory with scene.yaml and coupling_summary.json: {e}")
+            if r["status"] == "ok":
+                cache[r["run"]] = r
+            continue
         try:
             for r in json.load(open(path))["runs"]:
                 if r["status"] == "ok":

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Error against run time for a coupled scene (issue 17): runs the scene at a ladder of settings for
+"""Error against run time for a coupled scene: runs the scene at a ladder of settings for
 each discretization knob and reports, per knob and output, the error against the finest run of the
 ladder (or its Richardson extrapolation when three runs show a clean convergence order).
 

@@ -1,4 +1,4 @@
-// beam_solver: the stent side of the angioplasty co-simulation (DESIGN §2).
+// beam_solver: the stent side of the angioplasty co-simulation (docs/design.md §3).
 //   beam_solver --scene FILE --run-dir DIR                       beam-only scene (standalone loop)
 //   beam_solver --scene FILE --run-dir DIR --endpoint E --run-id ID   co-simulation (serves the
 //                                                                      beam role to the coupler)

@@ -1,4 +1,4 @@
-// Dirichlet–Neumann on the contact line loads (DESIGN §2 "Coupling iteration"): q_k in, q~_k out.
+// Dirichlet–Neumann on the contact line loads (docs/design.md §5.2): q_k in, q~_k out.
 #include "angio/coupler/dirichlet_neumann.hpp"
 
 #include "interface_vectors.hpp"

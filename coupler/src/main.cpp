@@ -1,6 +1,6 @@
 // coupler: owns the load steps and the coupling iteration of a run (Dirichlet–Neumann or robin,
 // coupling_loop.hpp); talks to beam_solver and solid_solver over zenoh and never touches element
-// data (DESIGN §2).
+// data (docs/design.md §3).
 #include <algorithm>
 #include <chrono>
 #include <csignal>

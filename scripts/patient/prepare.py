@@ -34,7 +34,7 @@ KEYS = {
     "balloon_spline": ("map", {}),
 }
 WALL_KEYS = {"thickness": ("from_centerline_or_number", "from_centerline"),
-             # thickness / outer diameter; see README "Patient-specific arteries" for the source
+             # thickness / outer diameter; see docs/user-guide.md "Patient-specific arteries" for the source
              "media_ratio": ("fraction", 0.06), "adventitia_ratio": ("fraction", 0.065),
              "min_intima": ("positive", 0.05)}
 MESH_KEYS = {"size": ("positive", 0.8), "binary": ("bool", True), "loft_spacing": ("positive", 0.5)}

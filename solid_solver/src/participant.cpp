@@ -15,6 +15,25 @@
 
 namespace angio::solid {
 
+namespace {
+// The concatenation of every rank's `mine` on rank 0 (rank order); empty on the other ranks.
+std::vector<double> gather_on_root(MPI_Comm comm, const std::vector<double>& mine) {
+  int size = 1, rank = 0;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  const int count = int(mine.size());
+  std::vector<int> counts(size), displs(size, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  std::vector<double> all;
+  if (rank == 0) {
+    for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+    all.resize(displs.back() + counts.back());
+  }
+  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm);
+  return all;
+}
+}  // namespace
+
 SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run_dir)
     : comm_(comm), scene_(std::move(scene)) {
   MPI_Comm_rank(comm_, &rank_);
@@ -198,17 +217,7 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
     c /= double(el.nn());
     mine.insert(mine.end(), {double(el.block), p1[i], vol[i], c(0), c(1), c(2)});
   }
-  int size = 1;
-  MPI_Comm_size(comm_, &size);
-  const int count = int(mine.size());
-  std::vector<int> counts(size), displs(size, 0);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
-  std::vector<double> all;
-  if (rank_ == 0) {
-    for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-    all.resize(displs.back() + counts.back());
-  }
-  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm_);
+  const std::vector<double> all = gather_on_root(comm_, mine);
   const size_t nb = mesh.blocks.size();
   s.stress.assign(nb, BlockStress{});
   if (rank_ != 0) return;
@@ -239,17 +248,7 @@ void SolidRunner::nodal_stress_(StepSummary& s) const {
     for (int b = 0; b < nb; ++b)
       if (rec.has(i, b)) mine.insert(mine.end(), {double(b), rec.p1(i, b), rec.weight(i, b), lumen, x(0), x(1), x(2)});
   }
-  int size = 1;
-  MPI_Comm_size(comm_, &size);
-  const int count = int(mine.size());
-  std::vector<int> counts(size), displs(size, 0);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
-  std::vector<double> all;
-  if (rank_ == 0) {
-    for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-    all.resize(displs.back() + counts.back());
-  }
-  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm_);
+  const std::vector<double> all = gather_on_root(comm_, mine);
   if (rank_ != 0) return;
   std::vector<std::vector<double>> values(nb), weights(nb);
   for (size_t k = 0; k + 6 < all.size(); k += 7) {

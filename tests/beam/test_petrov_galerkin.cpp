@@ -1,5 +1,5 @@
 // Petrov–Galerkin residual of 4C's beam3r (Jelenić & Crisfield 1999) as an alternative to the
-// consistent variation (ResidualForm, element.hpp; issue 17 item 3):
+// consistent variation (ResidualForm, element.hpp):
 //   tangent vs finite differences, agreement/disagreement with the consistent form at the
 //   element level, refinement of a plastic cantilever under a tip moment with both forms, the
 //   LU backends on the non-symmetric tangent, and the scene key stent.element.residual.

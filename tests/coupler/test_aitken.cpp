@@ -1,6 +1,6 @@
 // Aitken relaxation: on a linear fixed-point map q -> A q + b its secant update reaches the
 // fixed point in two updates for a scalar map (exact property of the method); factors follow
-// DESIGN §2 at the first iteration of a step.
+// docs/design.md §5.4 at the first iteration of a step.
 #include <gtest/gtest.h>
 
 #include "angio/coupler/aitken.hpp"

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""End-to-end tests of the coupled process chain over zenoh (issue 2 item 8, issue 6 item 3a):
+"""End-to-end tests of the coupled process chain over zenoh:
 
 1. coupler + two spring test participants, started by scripts/launch.py: the converged contact
    force equals the analytic coupled solution (spring_participants.hpp), a recording is written.
@@ -10,7 +10,7 @@
 4. a coupler without participants fails with a timeout error instead of hanging.
 5. a frozen participant (SIGSTOP) stops the run within --timeout + a few seconds, the coupler names
    it, the launcher passes the coupler's diagnosis on, the summary says failed, nothing is left.
-6. peer authentication (README "Security"): a foreign replier on the solid's keys answering every
+6. peer authentication (docs/reliability.md "Security"): a foreign replier on the solid's keys answering every
    request first does not change the run (same coupling history as run 1); a forged coupler
    sending the recorded requests with another key gets no answer; a participant with another key
    file is refused by name; a key file readable by others, or none, is bad input (exit 2, named).

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Multi-process tests of the real executables over zenoh (issue 2 item 8; issue 6 item 3b/c).
+"""Multi-process tests of the real executables over zenoh: the coupled chain, replay and faults.
 
 1. coupler + beam_solver + solid_solver (mpirun -n 2) run the tiny coupled scene end to end,
    started by scripts/launch.py, and shut down cleanly.

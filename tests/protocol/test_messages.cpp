@@ -1,4 +1,4 @@
-// Message round trips and rejection of malformed, foreign and old messages (issue 2, item 4).
+// Message round trips and rejection of malformed, foreign and old messages.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
 // Scene loading: values are read with their key path, and every bad input gives an error that
-// names the file, the key path and what was expected (issue 2, item 5).
+// names the file, the key path and what was expected.
 #include <gtest/gtest.h>
 
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// Peer authentication (msg::RunKey, README "Security"): HMAC-SHA256 tags over whole envelopes.
+// Peer authentication (msg::RunKey, docs/reliability.md "Security"): HMAC-SHA256 tags over whole envelopes.
 // Consistency checks (round trip, every single-byte alteration refused, another key refused) and
 // the wire format against an independent HMAC-SHA256 (RFC 2104), Python's hmac module:
 //   hmac.new(bytes([7] * 32), b"angio-seal-1" + b"hello", hashlib.sha256).hexdigest()

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Bad input in the generic artery scene's keys is refused through the launcher: exit code 2 and a
-message naming the file and the key path (README "Scenes"). One case per new key of the artery
+message naming the file and the key path (docs/user-guide.md "Scenes"). One case per new key of the artery
 procedure: viscous tau <= 0, beta < 0, apposition threshold < 0, a layer without a material,
 an unknown key in the viscous branch, too many lumen stations; a solid Newton atol of the order of
 the peak pressure load and a coupling rel_tol of 1 (tolerances that pass a step before it moves).

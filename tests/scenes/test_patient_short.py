@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The patient pipeline end to end in CI (issue 16): a tiny curved centerline with a stenosis (8 mm,
+"""The patient pipeline end to end in CI: a tiny curved centerline with a stenosis (8 mm,
 CSV x,y,z,r,wall), a 3-ring stent on a 6.5 mm balloon, a coarse tet10 three-layer artery, through
 the launcher: blood pressure and the start of the inflation (12 load steps) with configs/patient_like.yaml's
 materials, contact and solvers. Checks: exit 0; the placement meets eq. (3) (or the least-squares cubic)

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The default scene of the README run command, run whole: configs/straight_free_expansion.yaml.
 
-Published benchmark (paper §3.1, DESIGN §4): the stent's mean diameter at 13 atm (≈2.59 mm) and
+Published benchmark (paper §3.1; docs/validation.md, Paper comparison): the stent's mean diameter at 13 atm (≈2.59 mm) and
 after deflation (2.31 mm), and the elastic recoil (0.28 mm); accepted within 2 % for the
 diameters and 10 % for the recoil, the precision to which the paper's figures state them.
 Consistency: the run reaches t = 2 s with every step committed (adaptive steps: at most the 100

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Consistency/robustness test of scripts/launch.py (reliability issue): bad input and faults.
+"""Consistency/robustness test of scripts/launch.py: bad input and faults (docs/reliability.md).
 
 Checks that the launcher
 - refuses bad input with exit code 2 and one line `launch: error: <file>: <key path>: expected ...,

@@ -1,4 +1,4 @@
-// "Corrugated rings" stent generator (paper §2.2, DESIGN §3) and warping onto a centerline.
+// "Corrugated rings" stent generator (paper §2.2, docs/design.md §7.1) and warping onto a centerline.
 //
 // Geometry (straight stent, axis = z, rings start at z = 0):
 //  * ring k (k = 0..rings−1) is a zigzag of 2·crowns struts around the crimped circumference;

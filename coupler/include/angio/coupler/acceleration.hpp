@@ -1,5 +1,5 @@
-// Acceleration of the Dirichlet–Neumann fixed-point iteration q_{k+1} = q_k + Δq_k (DESIGN §2
-// "Coupling iteration"). The coupling loop only sees this interface, so IQN-ILS or other schemes
+// Acceleration of the Dirichlet–Neumann fixed-point iteration q_{k+1} = q_k + Δq_k
+// (docs/design.md §5.4). The coupling loop only sees this interface, so IQN-ILS or other schemes
 // can be added next to Aitken without touching the loop.
 #pragma once
 

@@ -1,7 +1,7 @@
 // Aitken's dynamic relaxation (Irons & Tuck 1969; Küttler & Wall 2008, Eq. 44):
 //   ω_k = −ω_{k−1} · r_{k−1}·(r_k − r_{k−1}) / ||r_k − r_{k−1}||²,   q_{k+1} = q_k + ω_k r_k.
 // First iteration of a step: ω_0 = sign(ω_prev)·min(ω_init, |ω_prev|) with ω_prev the last factor
-// of the previous step (ω_init at the very first step), as in DESIGN §2. |ω| is capped at ω_max.
+// of the previous step (ω_init at the very first step), as in docs/design.md §5.4. |ω| is capped at ω_max.
 #pragma once
 
 #include "angio/coupler/acceleration.hpp"

@@ -1,5 +1,5 @@
 // The staggered Dirichlet–Neumann (Gauss–Seidel) coupling of the beam and the solid per load
-// step, with acceleration, step acceptance/rejection and step cutting (DESIGN §2, paper §3).
+// step, with acceleration, step acceptance/rejection and step cutting (docs/design.md §5.2 and §6, paper §3).
 // Written against the participant interfaces: the same loop drives remote processes and
 // in-process participants (tests).
 #pragma once

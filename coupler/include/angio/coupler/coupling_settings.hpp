@@ -1,4 +1,4 @@
-// The scene's `coupling:` section (DESIGN §2 "Coupling iteration").
+// The scene's `coupling:` section (docs/design.md §5).
 //   coupling:
 //     scheme: dirichlet-neumann   # dirichlet-neumann | robin (interface_scheme.hpp)
 //     acceleration: aitken        # aitken | iqn-ils | constant

@@ -1,4 +1,4 @@
-// Dirichlet–Neumann on the contact line loads q (DESIGN §2): the beam is the Neumann side (q in,
+// Dirichlet–Neumann on the contact line loads q (docs/design.md §5.2): the beam is the Neumann side (q in,
 // positions out), the solid the Dirichlet side (positions in, q~ out); acceleration acts on q.
 #pragma once
 

@@ -1,4 +1,4 @@
-// What is iterated at the stent–solid interface within a load step (DESIGN §2):
+// What is iterated at the stent–solid interface within a load step (docs/design.md §5.2):
 //  - dirichlet-neumann: the contact line loads q; the beam takes q, the solid returns q~.
 //  - robin: the solid's contact planes (point s, normal n, penalty ε per sample point); the beam
 //    takes the planes and applies their penalty law q(x) = −ε⟨(x − s)·n − R⟩n inside its own

@@ -1,4 +1,4 @@
-// Robin coupling (DESIGN §2 "robin mode"): the iterate is the set of frozen contact planes the
+// Robin coupling (docs/design.md §5.3): the iterate is the set of frozen contact planes the
 // solid reports per sample point (point s, unit normal n toward the beam, penalty ε). The beam
 // adds their penalty law q(x) = −ε⟨(x − s)·n − R⟩n to its loads and linearizes it in its Newton
 // (participant/plane_penalty.hpp); the solid evaluates the true contact at the beam's positions

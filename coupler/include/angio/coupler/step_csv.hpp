@@ -1,4 +1,4 @@
-// The per-step CSV of a coupled run (DESIGN §6): one row per accepted load step.
+// The per-step CSV of a coupled run (docs/design.md §9): one row per accepted load step.
 #pragma once
 
 #include <fstream>

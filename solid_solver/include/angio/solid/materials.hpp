@@ -35,7 +35,7 @@ void add_stress(const NeoHooke& m, const Mat3& C, Mat3& S, Mat6* D);
 
 // One exponential fiber family (Holzapfel-Gasser-Ogden without dispersion, paper eq. B.4):
 //   Psi = k1/(2 k2) (exp(k2 (I4 - 1)^2) - 1),   I4 = a0 . C a0 (|a0| = 1),
-// by default in tension only (Psi = 0 for I4 <= 1, DESIGN §3, as fibers buckle); tension_only =
+// by default in tension only (Psi = 0 for I4 <= 1, docs/design.md §7.3, as fibers buckle); tension_only =
 // false keeps it for I4 < 1 too, as eq. B.4 is printed (an "artificial" balloon fiber that resists
 // axial compression and hence bending).
 struct FiberFamily {

@@ -22,7 +22,7 @@ namespace angio::solid {
 
 class SolidModel;
 
-// Hook for contact (stent line-to-surface, balloon-artery surface-to-surface; a later issue).
+// Hook for contact (stent line-to-surface, balloon-artery surface-to-surface; stent_contact.hpp).
 // Called collectively from every assembly with the current configuration; implementations add
 // their residual (r = f_int - f_ext convention) and, if K is non-null, tangent contributions with
 // VecSetValues/MatSetValues(ADD_VALUES) using model.dof(node, component) global indices.

@@ -19,7 +19,7 @@
 
 namespace angio::solid {
 
-// Stent (line-to-surface) contact for the participant (a later issue): gets the beam sample points
+// Stent (line-to-surface) contact for the participant (stent_contact.hpp): gets the beam sample points
 // before each solve, acts as the model's ContactModel during Newton, and fills the reply afterwards.
 class StentContact : public ContactModel {
  public:

@@ -42,7 +42,7 @@ struct DiameterSpec {
 
 // solid.newton.atol must stay below this fraction of peak_load_norm (a scene error otherwise).
 inline constexpr double kMaxAtolOfLoad = 0.1;
-// Above this fraction the solver warns (see README "Error against run time", Newton-tolerance ladder).
+// Above this fraction the solver warns (see docs/validation.md "Error against run time", Newton-tolerance ladder).
 inline constexpr double kWarnAtolOfLoad = 1e-3;
 
 struct SolidScene {

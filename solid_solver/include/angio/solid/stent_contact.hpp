@@ -1,7 +1,7 @@
-// Contact in the solid solver (issue "Contact"): the contact kernels of solid_solver/contact wired into
+// Contact in the solid solver: the contact kernels of solid_solver/contact wired into
 // SolidModel's ContactModel hook.
 //
-//  * PenaltyStentContact: stent (beam sample points, DESIGN.md §2) against the balloon outer surface and/or
+//  * PenaltyStentContact: stent (beam sample points, docs/design.md §5.1) against the balloon outer surface and/or
 //    the artery endothelium, line-to-surface penalty (paper §2.5). A point may touch both surfaces; the line
 //    loads add up. The beam points are held fixed during the solid's Newton solve (Dirichlet–Neumann).
 //  * PenaltySurfaceContact: balloon outer surface (slave) against the artery endothelium (master),

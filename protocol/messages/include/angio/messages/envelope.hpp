@@ -1,4 +1,4 @@
-// Opening and checking received envelopes (DESIGN §2 "Transport"): every buffer is verified
+// Opening and checking received envelopes (docs/design.md §4.2): every buffer is verified
 // with the flatbuffers verifier before any field is read, then its identifier, protocol version,
 // run id and sequence number are checked. Anything wrong is a ProtocolError with a clear message,
 // never a crash.

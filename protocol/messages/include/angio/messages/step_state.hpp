@@ -1,4 +1,4 @@
-// The order of requests a participant accepts (DESIGN §2): Hello first; then per load step a
+// The order of requests a participant accepts (docs/design.md §4.4): Hello first; then per load step a
 // StepBegin (finite time and increment), solve requests for that step (a solid's with a finite
 // tolerance >= 0), and a StepEnd for that step;
 // Shutdown at any time. A request out of this order is refused with a ProtocolError (the role server

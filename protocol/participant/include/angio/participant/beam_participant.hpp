@@ -1,4 +1,4 @@
-// What the stent side must do to take part in a run, standalone or coupled (DESIGN §2).
+// What the stent side must do to take part in a run, standalone or coupled (docs/design.md §3).
 // beam_solver implements it; a replay participant implements it from a recording.
 #pragma once
 

@@ -1,4 +1,4 @@
-// zenoh key expressions of a run (DESIGN §2 "Transport"): angio/<run_id>/<role>/<verb> for
+// zenoh key expressions of a run (docs/design.md §4.3): angio/<run_id>/<role>/<verb> for
 // requests, angio/<run_id>/alive/<role> for liveliness tokens, angio/<run_id>/status for status
 // lines.
 #pragma once

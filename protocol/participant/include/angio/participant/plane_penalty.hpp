@@ -1,4 +1,4 @@
-// Penalty law of a frozen contact plane at one beam sample point (robin coupling mode, DESIGN §2):
+// Penalty law of a frozen contact plane at one beam sample point (robin coupling mode, docs/design.md §5.3):
 // the solid surface near the point is replaced by its tangent plane (point s, unit normal n
 // toward the beam), so the paper's penalty potential Π = ∫ ε/2 ⟨g⟩² ds (Eq. 4) with the gap of
 // Eq. 5 linearized to g(x) = (x − s)·n − R gives the line load and its derivative

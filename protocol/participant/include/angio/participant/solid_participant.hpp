@@ -1,4 +1,4 @@
-// What the balloon/artery side must do to take part in a run, standalone or coupled (DESIGN §2).
+// What the balloon/artery side must do to take part in a run, standalone or coupled (docs/design.md §3).
 // solid_solver implements it (collectively on all MPI ranks); a replay participant from a recording.
 #pragma once
 

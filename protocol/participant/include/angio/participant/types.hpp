@@ -1,4 +1,4 @@
-// Interface data exchanged between the beam and the solid side (DESIGN §2 "Interface data").
+// Interface data exchanged between the beam and the solid side (docs/design.md §5.1).
 // Plain C++ types so that neither solver depends on the other's linear algebra.
 #pragma once
 
@@ -28,7 +28,7 @@ struct SolveStats {
   std::string message;  // why it failed, for the error report
 };
 
-// Robin mode (DESIGN §2): frozen contact planes per sample point, point s (mm), unit normal n
+// Robin mode (docs/design.md §5.3): frozen contact planes per sample point, point s (mm), unit normal n
 // toward the beam and penalty eps (N/mm²; 0: no plane at this point). The beam adds the penalty
 // law q(x) = −eps·⟨(x − s)·n − R⟩·n of each plane to its loads and linearizes it in its Newton.
 // K planes per sample point (K ≥ 1), point-major: plane j of point i at index i·K + j; a point

@@ -1,4 +1,4 @@
-// Recording of the exchanges of a run (DESIGN §2 "Recording and replay"): every request the
+// Recording of the exchanges of a run (docs/design.md §4.6): every request the
 // coupler sends and the reply it gets, in order, as the raw flatbuffers bytes.
 //
 // File layout (little endian): "ANGIOREC" u32 format_version, u32 len + run id; then per exchange

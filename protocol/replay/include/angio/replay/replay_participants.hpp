@@ -1,5 +1,4 @@
-// Participants that answer from a recording instead of solving (DESIGN §2 "Recording and
-// replay"). They implement the ordinary participant interfaces, so the ordinary role server
+// Participants that answer from a recording instead of solving (docs/design.md §4.6). They implement the ordinary participant interfaces, so the ordinary role server
 // serves them, and the coupler cannot tell them from the real solvers. Each incoming request is
 // checked against the recorded one (same verb, step, accept flag; interface vectors equal within
 // a tolerance); a mismatch is an error naming the exchange.

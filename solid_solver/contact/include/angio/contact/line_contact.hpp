@@ -1,4 +1,4 @@
-// Line-to-surface penalty contact: beam (stent) sample points against solid surfaces (DESIGN.md §2).
+// Line-to-surface penalty contact: beam (stent) sample points against solid surfaces (docs/design.md §8).
 //
 // Per beam sample point x (weight w = arc length, mm; beam contact radius R) and surface:
 //   s, n   closest point on the surface and unit contact normal toward the beam
@@ -81,7 +81,7 @@ struct LineContactResult {
   ContactDiagnostics diag;
 };
 
-// Robin-mode data per beam point (DESIGN.md §2): the beam linearizes q(x) = -eps <(x - s).n - R> n.
+// Robin-mode data per beam point (docs/design.md §5.3): the beam linearizes q(x) = -eps <(x - s).n - R> n.
 // A point can see several surfaces; only one plane per point is representable, so the surface with the
 // smallest gap g among those with a closest point in range is reported (the line loads q above stay the exact
 // sum). found = false: no surface within the search radius (s, n zero).

@@ -53,7 +53,7 @@ class SurfaceSearch {
   // The constructor finds the free (boundary) edges of the surface: edges, keyed by their two corner node ids,
   // that belong to one face only. A projection onto a free edge or a corner on a free edge from BEHIND the
   // surface (d < 0) is rejected: such a point has passed beside the surface's rim, not through it
-  // (see README, "Free edges"). Disable with reject_behind_free_edges = false.
+  // (see solid_solver/contact/README.md, "Free edges"). Disable with reject_behind_free_edges = false.
   SurfaceSearch(const Surface& surface, double radius, bool reject_behind_free_edges = true);
   // Gather face coordinates from the current configuration, recompute boxes, rebuild (default) or refit the tree.
   void update(std::span<const Vec3> coords, bool rebuild = true);

@@ -15,7 +15,7 @@
 namespace angio::contact {
 
 struct SurfaceContactParams {
-  double penalty = 5.0;          // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see README
+  double penalty = 5.0;          // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see solid_solver/contact/README.md
   int quadrature_degree = 3;     // slave quadrature (face_rule): quad 2x2, tri 6 points
   bool two_pass = false;         // symmetric: both surfaces act as slave, each pass with eps/2
   bool compute_tangent = true;
