@@ -4,7 +4,7 @@
 Published benchmark (paper §3.1; docs/validation.md, Paper comparison): the stent's mean diameter at 13 atm (≈2.59 mm) and
 after deflation (2.31 mm), and the elastic recoil (0.28 mm); accepted within 2 % for the
 diameters and 10 % for the recoil, the precision to which the paper's figures state them.
-Consistency: the run reaches t = 2 s with every step committed (adaptive steps: at most the 100
+Consistency: the run reaches its end (t = 2.2 s: deflated at 2 s, then held) with every step committed (adaptive steps: at most the 110
 nominal ones, no cut), and the balloon (elastic) returns to its initial outer diameter 0.98 mm at
 zero pressure. The stent's dogboning, (D_distal - D_central)/D_distal, peaks at 20.4 % at
 10.4 atm in the paper: accepted within 10 % of its value (a ratio of diameter differences, read at
@@ -36,8 +36,8 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 0, f"launch exits 0 (got {r.returncode})\n{r.stderr[-2000:]}")
     if r.returncode == 0:
         coupling = json.loads((run_dir / "coupling_summary.json").read_text())
-        check(coupling["status"] == "ok" and coupling["steps"] <= 100 and coupling["rejected_attempts"] == 0,
-              f"at most the 100 nominal steps, none cut ({coupling['steps']}, {coupling['rejected_attempts']} cut)")
+        check(coupling["status"] == "ok" and coupling["steps"] <= 110 and coupling["rejected_attempts"] == 0,
+              f"at most the 110 nominal steps, none cut ({coupling['steps']}, {coupling['rejected_attempts']} cut)")
         d = json.loads((run_dir / "beam" / "summary.json").read_text())["diameter"]
         check(near(d["max"], 2.59, 0.02), f"stent diameter at 13 atm {d['max']:.4f} mm vs paper 2.59 (2 %)")
         check(near(d["final"], 2.31, 0.02), f"stent diameter after deflation {d['final']:.4f} mm vs paper 2.31 (2 %)")
@@ -49,7 +49,7 @@ with tempfile.TemporaryDirectory() as tmp:
         p_dog = 13.0 * min(t_dog, 2.0 - t_dog)  # the pressure curve: 0 -> 13 atm at t = 1 s -> 0 at 2 s
         check(8.0 <= p_dog <= 12.0, f"stent dogboning peaks at {p_dog:.2f} atm, in the lock-up (8-12 atm; paper 10.4)")
         last = json.loads((run_dir / "solid" / "summary.json").read_text())["steps"][-1]
-        check(abs(last["time"] - 2.0) < 1e-9, f"the last committed step is at t = 2 s ({last['time']})")
+        check(abs(last["time"] - 2.2) < 1e-9, f"the last committed step is at t = 2.2 s ({last['time']})")
         mid = last["balloon_outer_diameter"]["mid"]
         check(near(mid, 0.98, 1e-3), f"balloon outer diameter after deflation {mid:.5f} mm vs initial 0.98")
 
