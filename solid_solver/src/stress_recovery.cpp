@@ -52,16 +52,33 @@ StressRecovery::StressRecovery(const SolidModel& model, Mass mass) : model_(mode
   std::vector<PetscScalar> share;
   const auto& le = model.local_elements();
   gauss_offset_.resize(le.size());
+  load_offset_.resize(le.size());
+  rows_offset_.resize(le.size());
   size_t offset = 0;
+  std::vector<Mat3> unit;
+  Eigen::MatrixXd be;
   for (size_t i = 0; i < le.size(); ++i) {
     const auto& el = mesh.elements[le[i]];
+    const int ng = int(volume_rule(el.type).size());
+    if (ng > 8 || el.nn() > 10)  // the capacity of recover()'s element buffers
+      throw std::invalid_argument("stress recovery: an element with more than 10 nodes or 8 Gauss points");
     gauss_offset_[i] = offset;
-    offset += volume_rule(el.type).size();
+    offset += ng;
     X.resize(el.nn(), 3);
     idx.resize(el.nn());
     for (int a = 0; a < el.nn(); ++a) {
       X.row(a) = mesh.X[el.n[a]].transpose();
       idx[a] = row_(el.n[a], el.block);
+    }
+    rows_offset_[i] = rows_.size();
+    rows_.insert(rows_.end(), idx.begin(), idx.end());
+    // column g of B_e: the 11-column of b for a unit σ_11 at Gauss point g alone
+    load_offset_[i] = load_.size();
+    for (int g = 0; g < ng; ++g) {
+      unit.assign(ng, Mat3::Zero());
+      unit[g](0, 0) = 1.0;
+      recovery_element(el.type, X, unit.data(), nullptr, &be);
+      load_.insert(load_.end(), be.col(0).data(), be.col(0).data() + el.nn());
     }
     const double V = recovery_element(el.type, X, nullptr, &Me, nullptr);
     share.assign(el.nn(), V / el.nn());
@@ -140,18 +157,19 @@ bool StressRecovery::recover(const std::vector<Mat3>& gauss) {
     throw std::invalid_argument("stress recovery: " + std::to_string(gauss.size()) + " Gauss-point stresses, expected " +
                                 std::to_string(expected));
   for (int k = 0; k < 6; ++k) ANGIO_PETSC(VecSet(b_[k], 0.0));
-  Eigen::MatrixXd X, be;
-  std::vector<PetscInt> idx;
+  // b_e = B_e S_e; fixed-capacity buffers (at most 10 nodes, 8 Gauss points): no allocation per element
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 8, 6> S;
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 10, 6> be;
   for (size_t i = 0; i < le.size(); ++i) {
     const auto& el = mesh.elements[le[i]];
-    X.resize(el.nn(), 3);
-    idx.resize(el.nn());
-    for (int a = 0; a < el.nn(); ++a) {
-      X.row(a) = mesh.X[el.n[a]].transpose();
-      idx[a] = row_(el.n[a], el.block);
-    }
-    recovery_element(el.type, X, gauss.data() + gauss_offset_[i], nullptr, &be);
-    for (int k = 0; k < 6; ++k) ANGIO_PETSC(VecSetValues(b_[k], el.nn(), idx.data(), be.col(k).data(), ADD_VALUES));
+    const int n = el.nn(), ng = int(volume_rule(el.type).size());
+    const Mat3* sg = gauss.data() + gauss_offset_[i];
+    S.resize(ng, 6);
+    for (int g = 0; g < ng; ++g)
+      for (int k = 0; k < 6; ++k) S(g, k) = sg[g](kVoigt[k][0], kVoigt[k][1]);
+    be.noalias() = Eigen::Map<const Eigen::MatrixXd>(load_.data() + load_offset_[i], n, ng) * S;
+    for (int k = 0; k < 6; ++k)
+      ANGIO_PETSC(VecSetValues(b_[k], n, rows_.data() + rows_offset_[i], be.col(k).data(), ADD_VALUES));
   }
   for (int k = 0; k < 6; ++k) ANGIO_PETSC(VecAssemblyBegin(b_[k]));
   for (int k = 0; k < 6; ++k) ANGIO_PETSC(VecAssemblyEnd(b_[k]));

@@ -62,6 +62,14 @@ class StressRecovery {
   Mass mass_;
   int nb_ = 0, nloc_ = 0;
   std::vector<size_t> gauss_offset_;   // per local element: its first entry in the gauss vector
+  // The right-hand side is linear in the Gauss-point stresses and the mesh is the reference one: per
+  // local element the constant matrix B_e (n × n_gauss, column-major) with b_e = B_e S_e, S_e the
+  // element's Gauss-point stresses as Voigt rows, and the element's rows of the system; both computed
+  // once in the constructor, so a step does no quadrature.
+  std::vector<double> load_;
+  std::vector<size_t> load_offset_;
+  std::vector<PetscInt> rows_;         // per local element its nn() rows, from rows_offset_
+  std::vector<size_t> rows_offset_;
   std::vector<double> weight_, p1_;    // per owned (node, block)
   std::vector<std::array<double, 6>> sigma_;  // per owned (node, block), Voigt
   Mat M_ = nullptr;
