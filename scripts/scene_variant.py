@@ -6,8 +6,10 @@ process). Scene names resolve the same way in all of them (resolve_scene); chang
 key paths are applied the same way in all of them (apply_set)."""
 import contextlib
 import copy
+import json
 import os
 import shutil
+import subprocess
 import sys
 
 import yaml
@@ -65,3 +67,13 @@ def resolve_scene(name):
 def launch_command(scene_path, run_dir, build_dir, *options):
     return [sys.executable, os.path.join(ROOT, "scripts", "launch.py"), scene_path, "--run-dir", run_dir,
             "--build-dir", build_dir, *options]
+
+
+def coupling_settings(scene_path, build_dir):
+    """The scene's coupling settings as the coupler runs them, every default filled in
+    (`coupler --print-settings`): the defaults are declared once, in the C++."""
+    exe = os.path.join(build_dir, "bin", "coupler")
+    out = subprocess.run([exe, "--scene", scene_path, "--print-settings"], capture_output=True, text=True)
+    if out.returncode != 0:
+        raise ValueError(f"{exe} --print-settings failed: {out.stderr.strip() or out.stdout.strip()}")
+    return json.loads(out.stdout)

@@ -42,7 +42,7 @@ import time
 
 import yaml
 
-from scene_variant import launch_command, resolve_scene, variant_scene
+from scene_variant import coupling_settings, launch_command, resolve_scene, variant_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
@@ -95,15 +95,15 @@ def _set_beam(s, n):
     g["elements_per_connector"] = n
 
 
-def knobs(scene, quick):
+def knobs(scene, quick, coupling):
+    """coupling: the scene's coupling settings as run (scene_variant.coupling_settings)."""
     t = scene.get("time", {})
-    c = scene.get("coupling", {})
     nw = scene.get("solid", {}).get("newton", {})
     g = scene.get("stent", {}).get("generator", {})
     out = {
         "steps": (_steps_levels(quick), _set_steps, 1.0, "load steps x", 2.0),
         "coupling_tol": ([1e-2, 1e-3, 1e-4] if quick else [1e-2, 3e-3, 1e-3, 3e-4, 1e-4], _set_coupling_tol,
-                         c.get("rel_tol", 1e-3), "coupling rel_tol", None),
+                         coupling["rel_tol"], "coupling rel_tol", None),
         "newton_tol": ([1e-4, 1e-6, 1e-8, 1e-10], _set_newton_tol, nw.get("rtol", 1e-8), "solid Newton rtol (atol alike)", 100.0),
         "mesh": ([1.0, 1.5, 2.0], _set_mesh, 1.0, "mesh refinement x", None),
         "beam": ([2, 3] if quick else [2, 3, 4, 6], _set_beam, g.get("elements_per_strut", 3),
@@ -311,7 +311,11 @@ def main():
     if not (isinstance(base, dict) and "stent" in base and ("balloon" in base or "artery" in base)):
         print(f"work_precision: {base_path}: expected a coupled scene (stent and balloon/artery)", file=sys.stderr)
         return 2
-    all_knobs = knobs(base, a.quick)
+    try:
+        all_knobs = knobs(base, a.quick, coupling_settings(base_path, a.build_dir))
+    except (OSError, ValueError) as e:
+        print(f"work_precision: {base_path}: cannot read its coupling settings: {e}", file=sys.stderr)
+        return 2
     chosen = a.knobs.split(",") if a.knobs else (["steps", "coupling_tol", "beam"] if a.quick else list(all_knobs))
     for k in chosen:
         if k not in all_knobs:

@@ -2,6 +2,8 @@
 
 #include "angio/coupler/aitken.hpp"
 
+#include <nlohmann/json.hpp>
+
 namespace angio::coupler {
 
 CouplingSettings coupling_settings(const scene::Node& root) {
@@ -44,6 +46,27 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   s.record = c->boolean_or("record", s.record);
   if (c->has("inexact_solid")) s.inexact_solid = c->in_range("inexact_solid", 0.0, 1.0);
   return s;
+}
+
+std::string settings_json(const CouplingSettings& s) {
+  nlohmann::ordered_json j = {{"scheme", s.scheme},
+                              {"acceleration", s.acceleration},
+                              {"initial_relaxation", s.initial_relaxation},
+                              {"max_relaxation", s.max_relaxation},
+                              {"max_iterations", s.max_iterations},
+                              {"rel_tol", s.rel_tol},
+                              {"abs_tol", s.abs_tol},
+                              {"strict", s.strict},
+                              {"restart_growth", s.restart_growth},
+                              {"prediction", s.prediction},
+                              {"record", s.record},
+                              {"inexact_solid", s.inexact_solid}};
+  if (s.acceleration == "iqn-ils")
+    j["iqn"] = {{"reused_steps", s.iqn.reused_steps},
+                {"max_columns", s.iqn.max_columns},
+                {"filter", s.iqn.filter},
+                {"stagnation", s.iqn.stagnation}};
+  return j.dump();
 }
 
 std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s) {

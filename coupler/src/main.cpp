@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
@@ -51,6 +52,10 @@ int run(const cli::Parser& args) {
   scene::ScaledCurve balloon_pressure;
   if (const auto b = root.optional("balloon"); b && b->has("pressure"))
     balloon_pressure = scene::scaled_curve(*b, "pressure", curves);
+  if (args.has("print-settings")) {  // the coupling settings as run, defaults filled in (scripts read them)
+    std::printf("%s\n", coupler::settings_json(settings).c_str());
+    return 0;
+  }
   if (args.has("check")) return 0;  // time, load curves and coupling settings are valid
   const fs::path run_dir = args.get("run-dir");
   // the run's key before anything is written: a missing or loose key file is bad input (exit 2)
@@ -147,9 +152,10 @@ int main(int argc, char** argv) {
                    "to --endpoint.");
   args.add_common();
   args.add({"record", "", "record every exchanged message into <run-dir>/exchanges.angiorec", ""});
+  args.add({"print-settings", "", "print the scene's coupling settings with every default filled in (JSON) and exit", ""});
   return cli::run_main(args, argc, argv, [&] {
     cli::setup_logging(args, "coupler");
-    if (args.has("check")) cli::require(args, {"scene"});
+    if (args.has("check") || args.has("print-settings")) cli::require(args, {"scene"});
     else cli::require(args, {"scene", "endpoint"});
     return run(args);
   });

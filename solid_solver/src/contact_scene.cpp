@@ -24,7 +24,7 @@ std::optional<double> read_line_pair(const Node& c, const std::string& key, std:
   if (!n) return def;
   if (disabled(*n)) return std::nullopt;
   n->check_keys({"penalty"});
-  return n->positive_or("penalty", def.value_or(10.0));
+  return n->positive_or("penalty", def.value_or(contact::kLinePenaltyDefault));
 }
 }  // namespace
 

@@ -41,22 +41,16 @@ const std::vector<QuadPoint>& volume_rule(ElemType t) {
 }
 
 const std::vector<QuadPoint>& face_rule(FaceType t) {
-  static const std::vector<QuadPoint> quad = [] {
+  // The contact library's tables (one copy of the points and weights): 2x2 Gauss on quads,
+  // 3 points on tri3 (degree 2), 6 points on tri6 (degree 4, Dunavant).
+  auto from_contact = [](FaceType f, int degree) {
+    const contact::QuadratureRule c = contact::face_rule(to_contact(f), degree);
     std::vector<QuadPoint> r;
-    const double g = 1.0 / std::sqrt(3.0);
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) r.push_back({{i ? g : -g, j ? g : -g, 0.0}, 1.0});
+    for (size_t i = 0; i < c.w.size(); ++i) r.push_back({{c.xi[i](0), c.xi[i](1), 0.0}, c.w[i]});
     return r;
-  }();
-  static const std::vector<QuadPoint> tri3 = {{{1.0 / 6, 1.0 / 6, 0}, 1.0 / 6},
-                                              {{2.0 / 3, 1.0 / 6, 0}, 1.0 / 6},
-                                              {{1.0 / 6, 2.0 / 3, 0}, 1.0 / 6}};
-  static const std::vector<QuadPoint> tri6 = [] {
-    const double a1 = 0.445948490915965, b1 = 0.108103018168070, w1 = 0.223381589678011 / 2;
-    const double a2 = 0.091576213509771, b2 = 0.816847572980459, w2 = 0.109951743655322 / 2;
-    return std::vector<QuadPoint>{{{a1, a1, 0}, w1}, {{b1, a1, 0}, w1}, {{a1, b1, 0}, w1},
-                                  {{a2, a2, 0}, w2}, {{b2, a2, 0}, w2}, {{a2, b2, 0}, w2}};
-  }();
+  };
+  static const std::vector<QuadPoint> quad = from_contact(FaceType::Quad4, 3), tri3 = from_contact(FaceType::Tri3, 2),
+                                      tri6 = from_contact(FaceType::Tri6, 4);
   switch (t) {
     case FaceType::Quad4: return quad;
     case FaceType::Tri3: return tri3;

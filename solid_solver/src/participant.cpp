@@ -88,6 +88,7 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
   recovery_ = std::make_unique<StressRecovery>(*model_);
   nodal_stress_names_ = nodal_stress_field_names(model_->mesh());
   time_ = scene_.time.start;
+  ok_time_ = committed_ok_time_ = time_;
   model_->start_at(time_);
   if (!run_dir.empty()) {
     dir_ = run_dir + "/solid";
@@ -160,8 +161,14 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
     warned_contact_ = true;
   }
   reset_reply(pts, reply);
+  const std::vector<double> u_start = model_->state();
   last_ = model_->solve(tolerance);
   totals_.add(last_);
+  if (!last_.converged && scene_.options.newton.continuation > 1) last_ = continuation_(pts, u_start, tolerance);
+  if (last_.converged) {
+    ok_time_ = time_;
+    ok_x_ = pts.x;
+  }
   if (stent_contact_ && last_.converged) stent_contact_->fill_reply(*model_, reply);
   participant::SolveStats s;
   s.converged = last_.converged;
@@ -178,11 +185,67 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
   return s;
 }
 
+SolveReport SolidRunner::continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start,
+                                       double tolerance) {
+  const SolveReport failed = last_;
+  // From the last converged state: sample points of a different count (the first solve of a run)
+  // are not interpolated, the pseudo-time still is.
+  const bool move_points = ok_x_.size() == pts.x.size();
+  participant::SamplePoints sub = pts;
+  auto set_stage = [&](double lambda) {
+    model_->set_time(ok_time_ + lambda * (time_ - ok_time_));
+    if (move_points)
+      for (size_t i = 0; i < pts.x.size(); ++i)
+        for (int c = 0; c < 3; ++c) sub.x[i][c] = ok_x_[i][c] + lambda * (pts.x[i][c] - ok_x_[i][c]);
+    if (stent_contact_) stent_contact_->set_points(sub);
+  };
+  model_->restore_state(u_start);
+  const double h_min = 1.0 / scene_.options.newton.continuation;
+  double lambda = 0.0, h = 0.5;
+  int stages = 0, halvings = 0;
+  SolveReport rep;
+  std::vector<double> u_stage;
+  while (lambda < 1.0) {
+    const double next = std::min(1.0, lambda + h);
+    set_stage(next);
+    u_stage = model_->state();
+    rep = model_->solve(tolerance);
+    totals_.add(rep);
+    if (rep.converged) {
+      lambda = next;
+      ++stages;
+      h = std::min(2.0 * h, 0.5);
+      continue;
+    }
+    model_->restore_state(u_stage);
+    h *= 0.5;
+    ++halvings;
+    if (h < h_min * (1.0 - 1e-12)) break;
+  }
+  set_stage(1.0);  // the solve's own time and points, whatever happened
+  if (lambda >= 1.0) {
+    if (rank_ == 0)
+      LOG_INFO("solid step " << step_ << " t = " << time_ << ": Newton failed (" << failed.message
+                             << "); continued in " << stages << " sub-increments (" << halvings << " halvings)");
+    return rep;
+  }
+  SolveReport out = failed;
+  std::ostringstream m;
+  m << failed.message << "; continuation stopped at " << lambda << " of the increment (sub-increment below 1/"
+    << scene_.options.newton.continuation << ": " << rep.message << ")";
+  out.message = m.str();
+  return out;
+}
+
 void SolidRunner::end_step(bool accept) {
   if (!accept) {
     model_->rollback();
+    ok_time_ = committed_ok_time_;
+    ok_x_ = committed_ok_x_;
     return;
   }
+  committed_ok_time_ = ok_time_;
+  committed_ok_x_ = ok_x_;
   model_->commit();
   ++committed_;
   record_and_write_(committed_, time_);

@@ -378,7 +378,7 @@ SolidScene read_solid_scene(const Node& root) {
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
       n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
-                     "damping_parts", "reuse_preconditioner", "tangent", "max_contraction"});
+                     "damping_parts", "reuse_preconditioner", "tangent", "max_contraction", "continuation"});
       auto& no = sc.options.newton;
       no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
       no.rtol = n->positive_or("rtol", no.rtol);
@@ -403,6 +403,10 @@ SolidScene read_solid_scene(const Node& root) {
       no.reuse_preconditioner = int(lag);
       no.modified = n->choice_or("tangent", {"exact", "modified"}, "exact") == "modified";
       no.max_contraction = n->positive_or("max_contraction", no.max_contraction);
+      const long cont = n->integer_or("continuation", no.continuation, 0, 1024);
+      if (cont == 1)
+        n->child("continuation").fail("0 (off) or the finest sub-increment as a fraction 1/N, N from 2 to 1024");
+      no.continuation = int(cont);
       if (!(no.max_contraction < 1.0)) n->child("max_contraction").fail("a contraction factor between 0 and 1 (exclusive)");
       if (n->optional("max_contraction") && !no.modified)
         n->child("max_contraction").fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");

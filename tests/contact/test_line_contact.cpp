@@ -1,6 +1,7 @@
 // Line-to-surface penalty contact: beam points against solid surfaces.
 #include <gtest/gtest.h>
 
+#include "angio/participant/penalty_law.hpp"
 #include "helpers.hpp"
 
 using namespace angio::contact;
@@ -295,4 +296,28 @@ TEST(LineContact, LinearQuadraticLawMatchesClosedFormAndTangents) {
   EXPECT_NEAR((force(1e-7) - force(-1e-7)) / 2e-7, -eps, 1e-3);
   check_tangent(FaceKind::Quad4, X, 1.0, BeamPoint{Vec3(0.3, 0.6, R - 0.01), w, R}, eps, g0);
   check_tangent(FaceKind::Quad4, X, 1.0, BeamPoint{Vec3(0.3, 0.6, R + 0.002), w, R}, eps, g0);
+}
+
+// The one penalty law (shared with the robin planes): f = −dπ/dg and k = −df/dg by central
+// differences on both branches, continuity of π, f, k at g = 0 and zero force at g = g0 (C¹ law).
+TEST(PenaltyLaw, DerivativesAndContinuity) {
+  using angio::participant::penalty_law;
+  const double eps = 10.0, h = 1e-6;
+  for (double g0 : {0.0, 0.005}) {
+    for (double g : {-0.02, -0.003, 0.001, 0.004}) {
+      if (!(g < g0)) continue;
+      const auto l = penalty_law(g, g0, eps), lp = penalty_law(g + h, g0, eps), lm = penalty_law(g - h, g0, eps);
+      EXPECT_NEAR(l.f, -(lp.pi - lm.pi) / (2 * h), 1e-7 * eps) << "g0 " << g0 << " g " << g;
+      EXPECT_NEAR(l.k, -(lp.f - lm.f) / (2 * h), 1e-6 * eps) << "g0 " << g0 << " g " << g;
+    }
+  }
+  const double g0 = 0.005;
+  const auto below = penalty_law(-1e-12, g0, eps), above = penalty_law(1e-12, g0, eps);
+  EXPECT_NEAR(below.pi, above.pi, 1e-12);
+  EXPECT_NEAR(below.f, above.f, 1e-10);
+  EXPECT_NEAR(below.k, above.k, 1e-8);
+  const auto end = penalty_law(g0, g0, eps);
+  EXPECT_DOUBLE_EQ(end.f, 0.0);
+  EXPECT_DOUBLE_EQ(end.pi, 0.0);
+  EXPECT_DOUBLE_EQ(penalty_law(-0.01, 0.0, eps).f, 0.1);  // linear law: ε |g|
 }

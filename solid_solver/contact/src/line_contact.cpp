@@ -4,6 +4,8 @@
 #include <cmath>
 #include <optional>
 
+#include "angio/participant/penalty_law.hpp"
+
 namespace angio::contact {
 
 void ContactDiagnostics::merge(const ContactDiagnostics& o) {
@@ -16,16 +18,8 @@ void ContactDiagnostics::merge(const ContactDiagnostics& o) {
 }
 
 namespace {
-// Penalty law of LineContactParams at gap g: potential pi(g), force magnitude f = −dpi/dg and k = −df/dg
-// (linear law for g0 = 0, the g0 → 0 limit of the linear-quadratic one).
-struct PenaltyLaw {
-  double pi, f, k;
-};
-PenaltyLaw penalty_law(double g, double g0, double eps) {
-  if (g0 <= 0.0) return {0.5 * eps * g * g, -eps * g, eps};
-  if (g <= 0.0) return {eps * (0.5 * g * g - 0.5 * g0 * g + g0 * g0 / 6.0), eps * (0.5 * g0 - g), eps};
-  return {eps * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0), 0.5 * eps * (g0 - g) * (g0 - g) / g0, eps * (g0 - g) / g0};
-}
+using participant::PenaltyLaw;
+using participant::penalty_law;  // the one law of the stent's line contact, shared with the robin planes
 
 // Common start of both point kernels: the gap g = d − R, activity g < g0, everything reset (r: 3 nn,
 // K: 3 nn x k_cols). Returns the penalty law at g if the point is active.

@@ -47,6 +47,9 @@ struct CouplingSettings {
 };
 
 CouplingSettings coupling_settings(const scene::Node& root);
+// The settings as one JSON object under the scene's key names (`coupler --print-settings`): the
+// defaults declared above, read by scripts instead of copying them.
+std::string settings_json(const CouplingSettings& s);
 std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s);
 
 }  // namespace angio::coupler

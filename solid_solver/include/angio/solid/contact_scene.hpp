@@ -23,8 +23,8 @@
 namespace angio::solid {
 
 struct ContactSpec {
-  std::optional<double> stent_balloon = 10.0;  // N/mm^2, unset: off
-  std::optional<double> stent_artery = 10.0;
+  std::optional<double> stent_balloon = contact::kLinePenaltyDefault;  // N/mm^2, unset: off
+  std::optional<double> stent_artery = contact::kLinePenaltyDefault;
   std::optional<PenaltySurfaceContact::Options> balloon_artery = PenaltySurfaceContact::Options{};
   double search_radius = 0.3;
   double line_regularization = 0.0;  // g0, mm (line_contact.hpp LineContactParams::regularization)

@@ -68,6 +68,14 @@ struct NewtonOptions {
   // between solves (the solid in a coupling loop). Exact Newton (false) factorizes every iteration.
   bool modified = false;
   double max_contraction = 0.25;
+  // Continuation of a failed solve: if Newton fails from the last converged state of the step (or
+  // the committed one), the change since that state (pseudo-time with its pressures, prescribed
+  // displacements, viscous and damping increments, and the stent's sample points) is applied in
+  // sub-increments, halved on failure down to 1/continuation of it and grown again after
+  // successes. Only the last sub-increment's equilibrium is kept: the result is that of the one
+  // full solve, reached from closer starting points (a homotopy in the load, as the load-step cut
+  // of the coupler, without repeating the coupling iterations of the step). 0 = off.
+  int continuation = 16;
 };
 
 struct ModelOptions {
@@ -152,6 +160,10 @@ class SolidModel {
   // advanced over Δt = t − t_committed from the committed one.
   void commit();
   void rollback();  // back to the last committed state (displacement; the viscous history is only ever committed)
+  // The whole displacement (new numbering, every rank): a solve's starting point, kept and restored
+  // by a continuation within the step (rollback() returns to the committed state instead).
+  const std::vector<double>& state() const { return u_; }
+  void restore_state(const std::vector<double>& u) { u_ = u; }
 
   // --- access (all ranks hold the full displacement)
   MPI_Comm comm() const { return comm_; }

@@ -130,6 +130,12 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner (by node)
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
   std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
+  // The last converged solve of the step (pseudo-time and sample points) and of the last committed
+  // step: where a continuation starts from.
+  double ok_time_ = 0.0, committed_ok_time_ = 0.0;
+  std::vector<participant::Vec3> ok_x_, committed_ok_x_;
+  SolveReport continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start,
+                            double tolerance);
   void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
   void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
   void nodal_stress_(StepSummary& s) const;  // from recovery_, into s.stress (rank 0)

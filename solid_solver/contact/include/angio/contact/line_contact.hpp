@@ -20,8 +20,12 @@ struct BeamPoint {
   double R = 0.0;         // beam contact radius (mm)
 };
 
+// The paper's line-contact penalty for stent–balloon and stent–artery (§2.5: ε = 10 N/mm², a line
+// load per mm of penetration), the default of every line-contact pair.
+inline constexpr double kLinePenaltyDefault = 10.0;
+
 struct LineContactParams {
-  double penalty = 10.0;         // eps (N/mm^2), paper value for stent-balloon and stent-artery
+  double penalty = kLinePenaltyDefault;  // eps (N/mm^2)
   // g0 (mm): 0 = the paper's linear penalty law q = −eps⟨g⟩ (Eq. 4); g0 > 0 = the C¹
   // "linear-quadratic" law of 4C's beam-to-solid contact: q = eps (g0/2 − g) for g ≤ 0,
   // eps (g0 − g)²/(2 g0) for 0 < g < g0, 0 beyond. It removes the jump of the stiffness at
