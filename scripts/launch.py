@@ -443,6 +443,9 @@ def main():
     ap.add_argument("--run-id", help="run id (default: random); replays need the recorded one")
     ap.add_argument("--beam-cmd", help="replace the beam participant executable (same CLI)")
     ap.add_argument("--solid-cmd", help="replace the solid participant executable (same CLI)")
+    ap.add_argument("--check", action="store_true",
+                    help="check the scene (every executable reads its keys; a patient's geometry is generated "
+                         "and meshed) and exit 0, or 2 naming the file and key; nothing is run or written")
     args = ap.parse_args()
     if not (math.isfinite(args.timeout) and args.timeout > 0):
         die(f"--timeout: expected a positive number of seconds, got {args.timeout}")
@@ -490,6 +493,10 @@ def main():
     for name, exe in checks:
         if exe:
             check_scene_with(name, exe, check_path)
+    if args.check:
+        asked = [name for name, exe in checks if exe]
+        print(f"launch: {scene_path}: the scene is valid ({', '.join(asked) or 'no executable'} asked)")
+        return 0
 
     token = uuid.uuid4().hex[:12]
     run_id = args.run_id or token

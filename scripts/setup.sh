@@ -40,3 +40,14 @@ if [ "$major" -lt 1 ] || { [ "$major" -eq 1 ] && [ "$minor" -lt 75 ]; }; then
   exit 1
 fi
 echo "setup: cargo $v"
+
+# The `angio` command (scripts/angio): a link in ~/.local/bin, which Debian's default ~/.profile puts
+# on PATH once the directory exists.
+if mkdir -p "$HOME/.local/bin" 2>/dev/null && ln -sf "$(cd "$(dirname "$0")" && pwd)/angio" "$HOME/.local/bin/angio"; then
+  case ":$PATH:" in
+    *":$HOME/.local/bin:"*) echo "setup: angio -> $HOME/.local/bin/angio" ;;
+    *) echo "setup: angio -> $HOME/.local/bin/angio (not on PATH in this shell: open a new login shell, or use scripts/angio)" ;;
+  esac
+else
+  echo "setup: could not link ~/.local/bin/angio; use scripts/angio"
+fi

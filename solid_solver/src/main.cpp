@@ -18,6 +18,7 @@
 #include "angio/participant/standalone.hpp"
 #include "angio/solid/contact_scene.hpp"
 #include "angio/solid/participant.hpp"
+#include "angio/solid/petsc_options_check.hpp"
 #include "angio/solid/scene.hpp"
 #ifdef ANGIO_SOLID_HAVE_SERVE
 #include "angio/participant/role_server.hpp"
@@ -61,6 +62,21 @@ int main(int argc, char** argv) {
       if (rank == 0) LOG_ERROR(e.what());
       PetscFinalize();
       return 2;
+    }
+    {  // PETSc's own types and packages: a refused option is bad input, before anything runs
+      const auto pc = angio::solid::check_petsc_options(scene.options.petsc_options);
+      if (!pc.error.empty()) {
+        if (rank == 0)
+          LOG_ERROR(cli.get("scene") << ": solid.petsc_options: expected options PETSc accepts, got \""
+                                     << scene.options.petsc_options << "\": " << pc.error);
+        PetscFinalize();
+        return 2;
+      }
+      if (rank == 0 && !pc.unused.empty()) {
+        std::string list;
+        for (const auto& u : pc.unused) list += " " + u;
+        LOG_WARN(cli.get("scene") << ": solid.petsc_options: not used by the linear solver (misspelt?):" << list);
+      }
     }
     if (cli.has("check")) {  // the scene is valid and its mesh was built (no run directory)
       PetscFinalize();

@@ -229,9 +229,24 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   }
 }
 
+// Plausible peaks (MPa) of the pressure loads: a value above them is a unit or typing error (kPa or
+// mmHg taken for MPa), which would otherwise run until a solver fails. Balloon: 4 MPa ≈ 39.5 atm,
+// above the rated burst pressure of non-compliant post-dilatation balloons (about 20–30 atm).
+// Blood: 0.04 MPa = 300 mmHg, above any physiological or hypertensive crisis pressure.
+constexpr double kMaxBalloonPressure = 4.0, kMaxBloodPressure = 0.04;
+
 PressureSpec read_pressure(const Node& parent, const std::string& key, const std::string& surface,
-                           const scene::LoadCurves& curves, const std::string& label) {
+                           const scene::LoadCurves& curves, const std::string& label, double max_peak,
+                           const char* limit_reason) {
   const scene::ScaledCurve c = scene::scaled_curve(parent, key, curves);
+  double peak = 0.0;
+  for (const auto& [t, v] : c.curve.points()) peak = std::max(peak, std::abs(c.value * v));
+  if (peak > max_peak) {
+    std::ostringstream m;
+    m << "a peak pressure (value x load curve) of at most " << max_peak << " MPa (" << limit_reason << "), got "
+      << peak << " MPa";
+    parent.child(key).fail(m.str());
+  }
   return PressureSpec{surface, c.value, c.curve, label};
 }
 
@@ -287,7 +302,8 @@ SolidScene read_solid_scene(const Node& root) {
       sc.materials.push_back(mi);
     }
     (void)boff;
-    if (b->has("pressure")) sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure"));
+    if (b->has("pressure")) sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure",
+                                                           kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
     if (b->has("end_springs")) {
       const double k = b->positive("end_springs");
       for (const char* s : {"balloon_end0", "balloon_end1"}) {
@@ -339,7 +355,8 @@ SolidScene read_solid_scene(const Node& root) {
     for (const auto& k : layers.keys())
       if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
     if (a->has("blood_pressure"))
-      sc.pressures.push_back(read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure"));
+      sc.pressures.push_back(read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure",
+                                             kMaxBloodPressure, "300 mmHg"));
     if (a->has("end_springs")) {
       const double k = a->positive("end_springs");
       for (const char* s : {"artery_end0", "artery_end1"}) {

@@ -3,7 +3,9 @@
 message naming the file and the key path (docs/user-guide.md "Scenes"). One case per new key of the artery
 procedure: viscous tau <= 0, beta < 0, apposition threshold < 0, a layer without a material,
 an unknown key in the viscous branch, too many lumen stations; a solid Newton atol of the order of
-the peak pressure load and a coupling rel_tol of 1 (tolerances that pass a step before it moves).
+the peak pressure load and a coupling rel_tol of 1 (tolerances that pass a step before it moves);
+pressures far outside any clinical range (units mistaken); PETSc options naming a preconditioner or
+factorization package that does not exist.
 No run directory is created (the launcher asks the executables with --check first).
 Usage: test_generic_artery_bad_input.py BIN_DIR
 """
@@ -35,6 +37,17 @@ CASES = [
     # tolerances that accept a step before it moves (the Newton ladder's atol 1 N ended "ok" uninflated)
     ("solid atol of the order of the load", lambda s: s["solid"]["newton"].update(atol=1.0), "solid.newton.atol"),
     ("coupling rel_tol 1", lambda s: s["coupling"].update(rel_tol=1.0), "coupling.rel_tol"),
+    # absurd values inside the type's range: a pressure in Pa or kPa taken for MPa
+    ("balloon pressure 1e6 MPa", lambda s: s["balloon"]["pressure"].update(value=1.0e6), "balloon.pressure"),
+    ("blood pressure 85 (mmHg for MPa)", lambda s: s["artery"]["blood_pressure"].update(value=85.0),
+     "artery.blood_pressure"),
+    # PETSc types and packages that do not exist (would fail at the first solve, after the start)
+    ("unknown preconditioner", lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lux"),
+     "solid.petsc_options"),
+    ("unknown factorization package",
+     lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumpz"),
+     "solid.petsc_options"),
+    ("continuation 1", lambda s: s["solid"]["newton"].update(continuation=1), "solid.newton.continuation"),
 ]
 
 with tempfile.TemporaryDirectory() as tmp:

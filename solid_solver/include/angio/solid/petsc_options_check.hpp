@@ -1,0 +1,20 @@
+// The scene's solid.petsc_options tried before anything runs: a Krylov method, preconditioner or
+// factorization package that PETSc does not know fails at the first solve otherwise, after the
+// mesh is built and the coupled processes have started.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace angio::solid {
+
+struct PetscOptionsCheck {
+  std::string error;                // PETSc's own message for the first refused option ("" = accepted)
+  std::vector<std::string> unused;  // options of `options` no object asked for (typos, or for other objects)
+};
+
+// Sets up and runs a KSP with petsc_default_options() and then `options` on a 2x2 system (this rank
+// only, PETSC_COMM_SELF; PETSc initialized). Never throws for a refused option.
+PetscOptionsCheck check_petsc_options(const std::string& options);
+
+}  // namespace angio::solid
