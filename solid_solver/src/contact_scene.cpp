@@ -1,5 +1,6 @@
 #include "angio/solid/contact_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -19,12 +20,48 @@ bool disabled(const Node& n) {
   n.fail("a map of options (e.g. {penalty: 10.0}) or 'off'");
 }
 
-std::optional<double> read_line_pair(const Node& c, const std::string& key, std::optional<double> def) {
+// `from` (s): the pair is off before this pseudo-time; absent: always on.
+double read_from(const Node& n) {
+  if (!n.has("from")) return kAlwaysActive;
+  return n.number("from");
+}
+
+std::optional<double> read_line_pair(const Node& c, const std::string& key, std::optional<double> def, double& from) {
   const auto n = c.optional(key);
   if (!n) return def;
   if (disabled(*n)) return std::nullopt;
-  n->check_keys({"penalty"});
+  n->check_keys({"penalty", "from"});
+  from = read_from(*n);
   return n->positive_or("penalty", def.value_or(contact::kLinePenaltyDefault));
+}
+
+// contact.insertion: the virtual insertion tool (insertion_tool.hpp).
+ContactSpec::Insertion read_insertion(const Node& n, const Node& root) {
+  n.check_keys({"axis", "radius", "penalty"});
+  ContactSpec::Insertion ins;
+  const Node axis = n.child("axis", "a polyline of at least 2 points [[x, y, z], ...] (mm)");
+  if (!axis.is_sequence() || axis.size() < 2) axis.fail("a polyline of at least 2 points [[x, y, z], ...] (mm)");
+  for (size_t i = 0; i < axis.size(); ++i) {
+    const Node p = axis.at(i);
+    if (!p.is_sequence() || p.size() != 3) p.fail("a point [x, y, z] (mm)");
+    Vec3d x;
+    for (int k = 0; k < 3; ++k) {
+      x(k) = p.at(k).as_number();
+      if (!std::isfinite(x(k))) p.at(k).fail("a finite coordinate (mm)");
+    }
+    if (!ins.axis.empty() && (x - ins.axis.back()).norm() < 1e-9) p.fail("a point distinct from the one before it");
+    ins.axis.push_back(x);
+  }
+  ins.radius = scene::scaled_curve(n, "radius", scene::load_curves(root));
+  double peak = 0.0, low = 0.0;
+  for (const auto& [t, v] : ins.radius.curve.points()) {
+    peak = std::max(peak, ins.radius.value * v);
+    low = std::min(low, ins.radius.value * v);
+  }
+  if (!(peak > 0.0) || low < 0.0 || peak > 50.0)
+    n.child("radius").fail("a radius (value x load curve) between 0 and 50 mm, positive somewhere");
+  ins.penalty = n.positive_or("penalty", ins.penalty);
+  return ins;
 }
 }  // namespace
 
@@ -39,21 +76,26 @@ ContactSpec read_contact_spec(const Node& root) {
     return spec;
   }
   c->check_keys({"stent_balloon", "stent_artery", "balloon_artery", "search_radius", "line_regularization", "line_normals",
-                "log"});
+                "log", "insertion"});
   spec.search_radius = c->positive_or("search_radius", spec.search_radius);
   spec.line_regularization = c->non_negative_or("line_regularization", spec.line_regularization);
   if (!(spec.line_regularization < 0.5 * spec.search_radius))
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
   spec.line_averaged_normals = c->choice_or("line_normals", {"closest_point", "averaged"}, "closest_point") == "averaged";
   spec.log = c->boolean_or("log", spec.log);
-  spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon);
-  spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery);
+  spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
+  spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);
+  if (const auto n = c->optional("insertion")) {
+    if (!root.has("artery") && !root.has("patient")) n->fail("no insertion tool without an artery (it opens the lumen)");
+    spec.insertion = read_insertion(*n, root);
+  }
   if (const auto n = c->optional("balloon_artery")) {
     if (disabled(*n)) {
       spec.balloon_artery.reset();
     } else {
-      n->check_keys({"penalty", "quadrature", "two_pass"});
+      n->check_keys({"penalty", "quadrature", "two_pass", "from"});
       auto& o = *spec.balloon_artery;
+      o.from = read_from(*n);
       o.penalty = n->positive_or("penalty", o.penalty);
       o.quadrature = int(n->integer_or("quadrature", o.quadrature, 1));
       if (o.quadrature > 7) n->child("quadrature").fail("a quadrature degree between 1 and 7");
@@ -75,6 +117,8 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   so.averaged_normals = spec.line_averaged_normals;
   if (has_balloon) so.balloon_penalty = spec.stent_balloon;
   if (has_artery) so.artery_penalty = spec.stent_artery;
+  so.balloon_from = spec.stent_balloon_from;
+  so.artery_from = spec.stent_artery_from;
   if (so.balloon_penalty || so.artery_penalty) {
     stent_ = std::make_unique<PenaltyStentContact>(model, so);
     composite_.set_stent(stent_.get());
@@ -82,6 +126,14 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   if (spec.balloon_artery && has_balloon && has_artery) {
     balloon_artery_ = std::make_unique<PenaltySurfaceContact>(model, *spec.balloon_artery);
     composite_.add_model(balloon_artery_.get());
+  }
+  if (spec.insertion && has_artery) {
+    InsertionTool::Options io;
+    io.axis = spec.insertion->axis;
+    io.radius = [r = spec.insertion->radius](double t) { return r.at(t); };
+    io.penalty = spec.insertion->penalty;
+    insertion_ = std::make_unique<InsertionTool>(model, io);
+    composite_.add_model(insertion_.get());
   }
   const bool log = spec.log;
   composite_.after_reply = [this, log](const SolidModel& m, const participant::ContactReply& reply) {
@@ -102,6 +154,11 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
       os << " balloon-artery: " << s.num_active << "/" << s.num_points << " Gauss points active, min gap " << s.min_gap
          << " mm, sum|f| " << s.force_magnitude << " N, area " << balloon_artery_->active_area() << " mm^2;";
     }
+    if (insertion_) {
+      const auto& s = insertion_->last();
+      os << " insertion: R " << insertion_->radius(m.time()) << " mm, " << s.num_active
+         << " nodes pushed, largest penetration " << -s.min_gap << " mm, sum|f| " << s.force_magnitude << " N;";
+    }
     os << " contact time " << dt_contact << " s of " << dt_solve << " s solve";
     if (dt_solve > 0) os << " (" << std::setprecision(3) << 100.0 * dt_contact / dt_solve << " %)";
     LOG_INFO(os.str());
@@ -110,6 +167,7 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   // forces on the endothelium per contact, in the runner's summary
   if (stent_) runner.add_contact_report("stent", stent_.get());
   if (balloon_artery_) runner.add_contact_report("balloon", balloon_artery_.get());
+  if (insertion_) runner.add_contact_report("insertion", insertion_.get());
 }
 
 ContactSetup::~ContactSetup() {

@@ -83,7 +83,7 @@ contact::Surface to_contact_surface(const SurfaceSet& s, double normal_sign) {
 
 PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) : opt_(std::move(opt)) {
   if (!(opt_.search_radius > 0)) throw std::runtime_error("stent contact: search radius must be positive");
-  auto add_surface = [&](const std::string& name, std::optional<double> eps) {
+  auto add_surface = [&](const std::string& name, std::optional<double> eps, double from) {
     if (!eps) return;
     const SurfaceSet* s = model.mesh().surface(name);
     if (!s || s->faces.empty()) return;
@@ -92,9 +92,10 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
     searches_.back()->enable_normal_field(opt_.averaged_normals);
     names_.push_back(name);
     penalty_.push_back(*eps);
+    from_.push_back(from);
   };
-  add_surface(opt_.balloon_surface, opt_.balloon_penalty);
-  add_surface(opt_.artery_surface, opt_.artery_penalty);
+  add_surface(opt_.balloon_surface, opt_.balloon_penalty, opt_.balloon_from);
+  add_surface(opt_.artery_surface, opt_.artery_penalty, opt_.artery_from);
   last_.min_gap = opt_.search_radius;
 }
 
@@ -108,17 +109,20 @@ void PenaltyStentContact::set_points(const participant::SamplePoints& pts) {
     points_[i] = contact::BeamPoint{contact::Vec3(pts.x[i][0], pts.x[i][1], pts.x[i][2]), pts.w[i], pts.radius[i]};
 }
 
+bool PenaltyStentContact::on_(std::size_t k, const SolidModel& model) const { return model.time() >= from_[k]; }
+
 std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const SolidModel& model,
                                                                        std::span<const contact::BeamPoint> points,
-                                                                       bool tangent) {
+                                                                       bool tangent, bool all) {
   std::vector<contact::LineContactResult> per_surface;
   if (points.empty() || searches_.empty()) return per_surface;
   gather_coords(model, coords_);
   for (size_t k = 0; k < searches_.size(); ++k) {
+    if (!all && !on_(k, model)) continue;
     searches_[k]->update(coords_, /*rebuild=*/true);
     const contact::SurfaceSearch* one[] = {searches_[k].get()};
     contact::LineContactParams par;
-    par.penalty = penalty_[k];
+    par.penalty = on_(k, model) ? penalty_[k] : 0.0;
     par.regularization = opt_.regularization;
     par.averaged_normals = opt_.averaged_normals;
     par.compute_tangent = tangent;
@@ -134,7 +138,7 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   std::size_t lo, hi;
   slice(points_.size(), model.rank(), model.size(), lo, hi);
   contact::ContactDiagnostics diag;
-  for (const auto& res : evaluate_(model, std::span(points_).subspan(lo, hi - lo), K != nullptr)) {
+  for (const auto& res : evaluate_(model, std::span(points_).subspan(lo, hi - lo), K != nullptr, false)) {
     insert(model, res.solid, r, K);
     diag.merge(res.diag);
   }
@@ -150,7 +154,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.n_active = 0;
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
-  const auto per_surface = evaluate_(model, points_, false);  // every rank: identical data, no communication
+  const auto per_surface = evaluate_(model, points_, false, true);  // every rank: identical data, no communication
   if (per_surface.empty()) return;
   // robin data: one plane per point and surface (K = number of surfaces, point-major), eps = 0 where
   // the surface has no face within the search radius
@@ -167,7 +171,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
       const auto& pc = per_surface[k].per_surface[0][i];
       const size_t j = i * K + k;
       reply.surface_points[j] = {points_[i].x(0), points_[i].x(1), points_[i].x(2)};
-      if (!pc.found) continue;
+      if (!pc.found || !on_(k, model)) continue;  // no plane (eps 0) where the pair is off
       active = active || pc.active;
       reply.surface_points[j] = {pc.proj.s(0), pc.proj.s(1), pc.proj.s(2)};
       reply.normals[j] = {pc.proj.n(0), pc.proj.n(1), pc.proj.n(2)};
@@ -187,7 +191,7 @@ void PenaltyStentContact::gaps(const SolidModel& model, const std::string& surfa
   weight.clear();
   const auto it = std::find(names_.begin(), names_.end(), surface);
   if (it == names_.end() || points_.empty()) return;
-  const auto per_surface = evaluate_(model, points_, false);  // every rank: identical data, no communication
+  const auto per_surface = evaluate_(model, points_, false, true);  // every rank: identical data, no communication
   const auto& pcs = per_surface[it - names_.begin()].per_surface[0];
   for (size_t i = 0; i < points_.size(); ++i) {
     gap.push_back(pcs[i].found ? pcs[i].gap : std::numeric_limits<double>::infinity());
@@ -223,8 +227,9 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
   const double t0 = MPI_Wtime();
   contact::ContactDiagnostics diag;
   double area = 0.0;
-  // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything
-  const bool mine = opt_.two_pass ? model.rank() == 0 : ss_ != nullptr;
+  // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything; nothing
+  // while the pair is off (the same time on every rank: the reduction below stays collective)
+  const bool mine = model.time() >= opt_.from && (opt_.two_pass ? model.rank() == 0 : ss_ != nullptr);
   if (mine) {
     gather_coords(model, coords_);
     ss_->update(coords_);

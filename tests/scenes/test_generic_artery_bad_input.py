@@ -48,6 +48,14 @@ CASES = [
      lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumpz"),
      "solid.petsc_options"),
     ("continuation 1", lambda s: s["solid"]["newton"].update(continuation=1), "solid.newton.continuation"),
+    # the virtual insertion tool and the contact switch-on time
+    ("insertion axis of one point", lambda s: s["contact"].update(insertion={"axis": [[0, 0, 0]], "radius": 0.7}),
+     "contact.insertion.axis"),
+    ("insertion radius negative", lambda s: s["contact"].update(insertion={"axis": [[0, 0, 0], [0, 0, 6]],
+                                                                           "radius": -0.7}),
+     "contact.insertion.radius"),
+    ("contact from not a time", lambda s: s["contact"].update(stent_artery={"penalty": 10.0, "from": "later"}),
+     "contact.stent_artery.from"),
 ]
 
 with tempfile.TemporaryDirectory() as tmp:

@@ -9,6 +9,10 @@
 //                                                  # normal field (continuous normal; normal_field.hpp)
 //     balloon_artery: {penalty: 5.0, quadrature: 3, two_pass: false}   # N/mm^3 (README of solid_contact); or `off`
 //     search_radius: 0.3                           # mm (> beam radius + largest penetration)
+//     insertion: {axis: [[x,y,z], ...], radius: {value: 0.7, curve: c}, penalty: 100.0}   # virtual
+//                                                  # insertion tool (insertion_tool.hpp); absent: none
+//   any pair: from: t                              # s: the pair is off before pseudo-time t (a device
+//                                                  # placed inside the wall waits for the insertion tool)
 //     log: true                                    # one line per converged solid solve (rank 0)
 //
 // Defaults (section or entry absent): the paper's values for the contact pairs whose surfaces exist
@@ -17,7 +21,9 @@
 #include <memory>
 #include <optional>
 
+#include "angio/scene/load_curve.hpp"
 #include "angio/scene/node.hpp"
+#include "angio/solid/insertion_tool.hpp"
 #include "angio/solid/stent_contact.hpp"
 
 namespace angio::solid {
@@ -26,6 +32,13 @@ struct ContactSpec {
   std::optional<double> stent_balloon = contact::kLinePenaltyDefault;  // N/mm^2, unset: off
   std::optional<double> stent_artery = contact::kLinePenaltyDefault;
   std::optional<PenaltySurfaceContact::Options> balloon_artery = PenaltySurfaceContact::Options{};
+  double stent_balloon_from = kAlwaysActive, stent_artery_from = kAlwaysActive;  // s
+  struct Insertion {
+    std::vector<Vec3d> axis;    // mm
+    scene::ScaledCurve radius;  // mm
+    double penalty = 100.0;     // N/mm^3
+  };
+  std::optional<Insertion> insertion;
   double search_radius = 0.3;
   double line_regularization = 0.0;  // g0, mm (line_contact.hpp LineContactParams::regularization)
   bool line_averaged_normals = false;  // LineContactParams::averaged_normals
@@ -52,6 +65,7 @@ class ContactSetup {
   SolidRunner& runner_;
   std::unique_ptr<PenaltyStentContact> stent_;
   std::unique_ptr<PenaltySurfaceContact> balloon_artery_;
+  std::unique_ptr<InsertionTool> insertion_;
   CompositeContact composite_;
 };
 

@@ -18,6 +18,7 @@
 // Units: mm, N, MPa.
 #pragma once
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -50,6 +51,9 @@ struct ContactTiming {
   void reset() { *this = {}; }
 };
 
+// A contact pair that is on at every time (the default of `from`).
+inline constexpr double kAlwaysActive = -std::numeric_limits<double>::infinity();
+
 class PenaltyStentContact : public StentContact {
  public:
   struct Options {
@@ -60,6 +64,7 @@ class PenaltyStentContact : public StentContact {
     bool averaged_normals = false;          // projection along the averaged normal field (line_contact.hpp)
     std::string balloon_surface = "balloon_outer";
     std::string artery_surface = "artery_inner";
+    double balloon_from = kAlwaysActive, artery_from = kAlwaysActive;  // s: off before these times
   };
   // Surfaces that the mesh does not have are skipped (e.g. no artery in a free expansion scene).
   PenaltyStentContact(const SolidModel& model, Options opt);
@@ -79,12 +84,16 @@ class PenaltyStentContact : public StentContact {
 
  private:
   // Updates the searches to the current configuration and evaluates `points` against each surface (own penalty).
+  // all = false: the surfaces that are off at the model's time are left out (add); true: they are
+  // evaluated with penalty 0 so that the results stay indexed by surface (reply, gaps).
   std::vector<contact::LineContactResult> evaluate_(const SolidModel& model, std::span<const contact::BeamPoint> points,
-                                                    bool tangent);
+                                                    bool tangent, bool all);
 
   Options opt_;
   std::vector<std::string> names_;
   std::vector<double> penalty_;
+  std::vector<double> from_;  // per surface: off before this time
+  bool on_(std::size_t k, const SolidModel& model) const;
   std::vector<std::unique_ptr<contact::Surface>> surfaces_;
   std::vector<std::unique_ptr<contact::SurfaceSearch>> searches_;
   std::vector<contact::BeamPoint> points_;
@@ -102,6 +111,7 @@ class PenaltySurfaceContact : public ContactModel {
     double search_radius = 0.3;
     std::string slave = "balloon_outer";
     std::string master = "artery_inner";
+    double from = kAlwaysActive;  // s: off before this time
   };
   // Throws std::runtime_error if a surface set is missing.
   PenaltySurfaceContact(const SolidModel& model, Options opt);

@@ -1,0 +1,49 @@
+// Virtual insertion: a rigid capsule of radius R(t) around the device axis (capsule_tool.hpp) pushes
+// the lumen surface out of itself, so that a device wider than the lesion can be placed without
+// starting inside the wall. The scene grows R from inside the narrowest lumen to the device's outer
+// radius plus a clearance while the stent's and balloon's contact with the artery is still off
+// (contact.<pair>.from), then shrinks it to 0 so that the wall comes to rest on the device.
+//
+//   contact:
+//     insertion:
+//       axis: [[0, 0, 0], [0, 0, 6]]          # mm, polyline (>= 2 points); the capsule's spine
+//       radius: {value: 0.7, curve: tool}     # mm × load curve (or a number: constant)
+//       penalty: 100.0                        # N/mm^3: pressure per mm of penetration
+//       surface: artery_inner                 # the surface it pushes (default)
+//
+// Each rank evaluates the surface nodes it owns (reference lumped nodal areas), so every node
+// enters the global system once. Units: mm, N, MPa, s.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "angio/solid/stent_contact.hpp"
+
+namespace angio::solid {
+
+class InsertionTool : public ContactModel {
+ public:
+  struct Options {
+    std::vector<Vec3d> axis;
+    std::function<double(double)> radius;  // R(t), mm
+    double penalty = 100.0;                // N/mm^3
+    std::string surface = "artery_inner";
+  };
+  // Throws std::runtime_error if the surface set is missing.
+  InsertionTool(const SolidModel& model, Options opt);
+  void add(const SolidModel& model, Vec r, Mat K) override;  // collective (diagnostics)
+
+  const ContactSummary& last() const { return last_; }  // min_gap: −(largest penetration) (mm)
+  double radius(double t) const { return opt_.radius(t); }
+
+ private:
+  Options opt_;
+  std::vector<contact::Vec3> axis_;
+  std::vector<int> nodes_;     // surface nodes owned by this rank (original numbering)
+  std::vector<double> area_;   // their lumped reference areas (mm^2)
+  ContactSummary last_;
+};
+
+}  // namespace angio::solid
