@@ -39,9 +39,15 @@ std::optional<double> read_line_pair(const Node& c, const std::string& key, std:
 ContactSpec::Insertion read_insertion(const Node& n, const Node& root) {
   n.check_keys({"axis", "radius", "penalty"});
   ContactSpec::Insertion ins;
-  const Node axis = n.child("axis", "a polyline of at least 2 points [[x, y, z], ...] (mm)");
-  if (!axis.is_sequence() || axis.size() < 2) axis.fail("a polyline of at least 2 points [[x, y, z], ...] (mm)");
-  for (size_t i = 0; i < axis.size(); ++i) {
+  const char* what = "'balloon' (its axis from end to end) or a polyline of at least 2 points [[x, y, z], ...] (mm)";
+  const Node axis = n.child("axis", what);
+  if (axis.is_scalar() && axis.as_string() == "balloon") {
+    if (!root.has("balloon")) axis.fail("a polyline (mm): this scene has no balloon");
+    ins.balloon_axis = true;
+  } else if (!axis.is_sequence() || axis.size() < 2) {
+    axis.fail(what);
+  }
+  for (size_t i = 0; !ins.balloon_axis && i < axis.size(); ++i) {
     const Node p = axis.at(i);
     if (!p.is_sequence() || p.size() != 3) p.fail("a point [x, y, z] (mm)");
     Vec3d x;
@@ -129,7 +135,8 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   }
   if (spec.insertion && has_artery) {
     InsertionTool::Options io;
-    io.axis = spec.insertion->axis;
+    io.axis = spec.insertion->balloon_axis ? runner.scene().balloon_spine : spec.insertion->axis;
+    if (io.axis.size() < 2) throw std::runtime_error("contact.insertion.axis: balloon: the balloon has no axis (a mesh file without one?)");
     io.radius = [r = spec.insertion->radius](double t) { return r.at(t); };
     io.penalty = spec.insertion->penalty;
     insertion_ = std::make_unique<InsertionTool>(model, io);

@@ -331,6 +331,11 @@ SolidScene read_solid_scene(const Node& root) {
       d.s_mid = 0.5 * (smin + smax);
       d.s_end0 = smin + end_offset;
       d.s_end1 = smax - end_offset;
+      const int n_spine = curved ? std::max(1, int(std::ceil((smax - smin) / 0.25))) : 1;
+      for (int i = 0; i <= n_spine; ++i) {
+        const double st = smin + (smax - smin) * i / n_spine;
+        sc.balloon_spine.push_back(curved ? Vec3d(curved->point(st)) : Vec3d(axis.origin + st * axis.direction));
+      }
       sc.balloon_diameter = d;
     }
     read_fixed(*b, "balloon_", m, sc.fixed);

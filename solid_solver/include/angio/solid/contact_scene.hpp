@@ -35,6 +35,7 @@ struct ContactSpec {
   double stent_balloon_from = kAlwaysActive, stent_artery_from = kAlwaysActive;  // s
   struct Insertion {
     std::vector<Vec3d> axis;    // mm
+    bool balloon_axis = false;  // axis: balloon (SolidScene::balloon_spine)
     scene::ScaledCurve radius;  // mm
     double penalty = 100.0;     // N/mm^3
   };

@@ -6,7 +6,8 @@
 //
 //   contact:
 //     insertion:
-//       axis: [[0, 0, 0], [0, 0, 6]]          # mm, polyline (>= 2 points); the capsule's spine
+//       axis: [[0, 0, 0], [0, 0, 6]]          # mm, polyline (>= 2 points); the capsule's spine,
+//                                             # or `balloon`: the balloon's axis from end to end
 //       radius: {value: 0.7, curve: tool}     # mm × load curve (or a number: constant)
 //       penalty: 100.0                        # N/mm^3: pressure per mm of penetration
 //       surface: artery_inner                 # the surface it pushes (default)

@@ -88,6 +88,7 @@ class SolidRunner : public participant::SolidParticipant {
   void finish() override;
 
   SolidModel& model() { return *model_; }
+  const SolidScene& scene() const { return scene_; }
   // Registers the stent contact (not owned; nullptr: no stent contact, zero line loads).
   void set_stent_contact(StentContact* contact) {
     stent_contact_ = contact;

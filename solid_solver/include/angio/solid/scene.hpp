@@ -53,6 +53,9 @@ struct SolidScene {
   std::vector<SpringSpec> springs;
   std::vector<FixedSpec> fixed;
   std::optional<DiameterSpec> balloon_diameter;
+  // The balloon's axis from end to end as a polyline (mm; the centerline sampled every 0.25 mm for a
+  // curved balloon): the spine of the insertion tool with `contact.insertion.axis: balloon`.
+  std::vector<Vec3d> balloon_spine;
   // Artery summary (artery.summary): lumen stations along the vessel axis (artery_inner nodes) and the
   // apposition threshold (a strut farther than this from the endothelium is malapposed).
   std::optional<DiameterSpec> lumen;  // node_set: "artery_inner"
