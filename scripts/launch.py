@@ -436,7 +436,8 @@ def main():
     ap.add_argument("--ranks", type=ranks_arg, help="MPI ranks of the solid solver (overrides solid.ranks)")
     ap.add_argument("--transport", choices=["auto", "unix", "tcp"], default="auto")
     ap.add_argument("--record", action="store_true", help="record all exchanges (coupled scenes)")
-    ap.add_argument("--timeout", type=float, default=600.0, help="peer silence timeout, s")
+    ap.add_argument("--timeout", type=float,
+                    help="peer silence timeout, s (default: the executables' own, `coupler --help`)")
     ap.add_argument("--log-level", default="info", choices=["debug", "info", "warn", "error"])
     ap.add_argument("--verbose", action="store_true",
                     help="show every participant's output on the terminal (default: coupler only)")
@@ -447,7 +448,7 @@ def main():
                     help="check the scene (every executable reads its keys; a patient's geometry is generated "
                          "and meshed) and exit 0, or 2 naming the file and key; nothing is run or written")
     args = ap.parse_args()
-    if not (math.isfinite(args.timeout) and args.timeout > 0):
+    if args.timeout is not None and not (math.isfinite(args.timeout) and args.timeout > 0):
         die(f"--timeout: expected a positive number of seconds, got {args.timeout}")
     if args.run_id is not None and not RUN_ID.fullmatch(args.run_id):
         die(f"--run-id: expected 1 to 64 of A-Z a-z 0-9 . _ -, got {shown(args.run_id)}")
@@ -515,8 +516,9 @@ def main():
             solver_scene = install_prepared(prepared, run_dir)
     except OSError as e:
         die(f"{run_dir}: cannot write the scene: {e.strerror}")
-    common = ["--scene", str(solver_scene), "--run-dir", str(run_dir), "--log-level", args.log_level,
-              "--timeout", str(args.timeout)]
+    common = ["--scene", str(solver_scene), "--run-dir", str(run_dir), "--log-level", args.log_level]
+    if args.timeout is not None:
+        common += ["--timeout", str(args.timeout)]
 
     plan = []
     if has_stent and has_solid:

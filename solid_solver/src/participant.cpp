@@ -161,10 +161,11 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
     warned_contact_ = true;
   }
   reset_reply(pts, reply);
-  const std::vector<double> u_start = model_->state();
+  const bool continuation = scene_.options.newton.continuation > 1;
+  const std::vector<double> u_start = continuation ? model_->state() : std::vector<double>{};
   last_ = model_->solve(tolerance);
   totals_.add(last_);
-  if (!last_.converged && scene_.options.newton.continuation > 1) last_ = continuation_(pts, u_start, tolerance);
+  if (!last_.converged && continuation) last_ = continuation_(pts, u_start, tolerance);
   if (last_.converged) {
     ok_time_ = time_;
     ok_x_ = pts.x;

@@ -27,7 +27,11 @@ Parser& Parser::add_common() {
        "the run's secret key (64 hex digits, mode 0600) that authenticates every message; default <run-dir>/run.key, "
        "which the launcher writes",
        ""});
-  add({"timeout", "SECONDS", "give up when the peer is silent or gone this long", "600"});
+  // One solid solve can take many minutes where the balloon unfolds against the wall (generic artery
+  // with the paper's end springs: up to 54 s per solve on 2 cores, a continued solve over 600 s): the
+  // silence that means a frozen peer is longer than that. A vanished peer is noticed at once anyway
+  // (liveliness token).
+  add({"timeout", "SECONDS", "give up when the peer is silent or gone this long", "1800"});
   add({"log-level", "LEVEL", "debug, info, warn or error", "info"});
   add({"check", "", "read and check the scene (and build the model), then exit: 0 valid, 2 the error", ""});
   return *this;
