@@ -59,11 +59,7 @@ ContactSpec::Insertion read_insertion(const Node& n, const Node& root) {
     ins.axis.push_back(x);
   }
   ins.radius = scene::scaled_curve(n, "radius", scene::load_curves(root));
-  double peak = 0.0, low = 0.0;
-  for (const auto& [t, v] : ins.radius.curve.points()) {
-    peak = std::max(peak, ins.radius.value * v);
-    low = std::min(low, ins.radius.value * v);
-  }
+  const auto [low, peak] = ins.radius.range();
   if (!(peak > 0.0) || low < 0.0 || peak > 50.0)
     n.child("radius").fail("a radius (value x load curve) between 0 and 50 mm, positive somewhere");
   ins.penalty = n.positive_or("penalty", ins.penalty);

@@ -16,7 +16,6 @@ namespace angio::solid {
 InsertionTool::InsertionTool(const SolidModel& model, Options opt) : opt_(std::move(opt)) {
   const SurfaceSet* s = model.mesh().surface(opt_.surface);
   if (!s) throw std::runtime_error("insertion tool: no surface set '" + opt_.surface + "'");
-  for (const auto& p : opt_.axis) axis_.push_back(p);
   const std::vector<double> area = nodal_areas(model.mesh(), *s);  // by node (0 off the surface)
   for (int n = 0; n < int(area.size()); ++n) {
     const int k = model.new_index(n);
@@ -36,7 +35,7 @@ void InsertionTool::add(const SolidModel& model, Vec r, Mat K) {
     for (std::size_t i = 0; i < nodes_.size(); ++i) {
       const int n = nodes_[i];
       const contact::ToolNodeContact c =
-          contact::capsule_node(contact::polyline_distance(axis_, model.position(n)), R, opt_.penalty * area_[i]);
+          contact::capsule_node(contact::polyline_distance(opt_.axis, model.position(n)), R, opt_.penalty * area_[i]);
       if (!c.active) continue;
       for (int k = 0; k < 3; ++k) idx[k] = model.dof(n, k);
       ANGIO_PETSC(VecSetValues(r, 3, idx, c.r.data(), ADD_VALUES));

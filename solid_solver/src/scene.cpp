@@ -239,8 +239,8 @@ PressureSpec read_pressure(const Node& parent, const std::string& key, const std
                            const scene::LoadCurves& curves, const std::string& label, double max_peak,
                            const char* limit_reason) {
   const scene::ScaledCurve c = scene::scaled_curve(parent, key, curves);
-  double peak = 0.0;
-  for (const auto& [t, v] : c.curve.points()) peak = std::max(peak, std::abs(c.value * v));
+  const auto [lo, hi] = c.range();
+  const double peak = std::max(std::abs(lo), std::abs(hi));
   if (peak > max_peak) {
     std::ostringstream m;
     m << "a peak pressure (value x load curve) of at most " << max_peak << " MPa (" << limit_reason << "), got "

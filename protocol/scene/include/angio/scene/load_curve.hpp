@@ -3,7 +3,8 @@
 //     pressure: [[0.0, 0.0], [1.0, 1.317], [2.0, 0.0]]   # [t (s), value]
 // and referenced by name from loads (e.g. `curve: pressure`). Constant outside the given range.
 #pragma once
-
+#include <algorithm>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -39,6 +40,16 @@ struct ScaledCurve {
   double value = 0.0;
   LoadCurve curve = LoadCurve::constant(1.0);
   double at(double t) const { return value * curve.value(t); }
+  // Smallest and largest value × curve (at the curve's points: piecewise linear, so these are its
+  // extremes).
+  std::pair<double, double> range() const {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& [t, v] : curve.points()) {
+      lo = std::min(lo, value * v);
+      hi = std::max(hi, value * v);
+    }
+    return {lo, hi};
+  }
 };
 // Reads `key` of `parent` in either form (the value of {value, curve} defaults to 1).
 ScaledCurve scaled_curve(const Node& parent, const std::string& key, const LoadCurves& curves);
