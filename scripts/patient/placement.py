@@ -13,6 +13,12 @@
   elsewhere) would come closer to the endothelium than the required margin, the weights of the
   lumen points there are doubled and the spline refitted, which pulls it toward the lumen centerline
   (paper: "an array of adapted weights w ... ensures no overlap").
+- A lesion narrower than a crimped device (`insertion=True`, the caller's choice): the devices are
+  placed all the same, on a spline kept inside the lumen (its axis at least half the narrowest lumen
+  radius under the balloon from the endothelium), and a virtual insertion tool opens the lumen before
+  the inflation (prepare.py); the clearances reported are then negative where a device overlaps
+  the wall, and `axis_clearance` is the smallest distance of the axis from the endothelium (the
+  tool's starting radius must lie below it).
 - The clearance is measured against the lumen as a tube: for a point q of the device axis, the
   nearest point of the lumen centerline polyline and the lumen radius r interpolated there;
   clearance = r − |q − nearest| − R_device.
@@ -52,6 +58,8 @@ class Placement:
     clearance_balloon: float        # min clearance of the balloon surface from the endothelium, mm
     clearance_stent: float
     clearance_where: dict = field(default_factory=dict)
+    axis_clearance: float = float("nan")   # min distance of the device axis from the endothelium, mm
+    insertion: bool = False                # devices placed into a lesion narrower than themselves
     spline: list = field(default_factory=list)   # per coordinate: knots, residual, condition
     weight_rounds: int = 0
     max_weight: float = 1.0
@@ -64,7 +72,8 @@ class Placement:
             "device_centerline_length": float(arc_length(self.points)[-1]),
             "balloon_start": self.balloon_start, "stent_start": self.stent_start,
             "clearance": {"balloon": self.clearance_balloon, "stent": self.clearance_stent,
-                          **self.clearance_where},
+                          "axis": self.axis_clearance, **self.clearance_where},
+            "insertion": self.insertion,
             "spline": self.spline, "weight_rounds": self.weight_rounds, "max_weight": self.max_weight,
         }
 
@@ -107,9 +116,27 @@ def stenosis_site(cl, s_given=None, where="patient.stenosis"):
     return float(s_given)
 
 
-def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.05, extension=None):
+def narrowest_under(cl, dev, s_site):
+    """{"stent": r, "balloon": r}: the narrowest lumen radius under each device placed at s_site (mm)."""
+    s = cl.arc_length
+    out = {}
+    for name, half in (("stent", 0.5 * dev.stent_length), ("balloon", 0.5 * dev.balloon_length)):
+        under = (s >= s_site - half) & (s <= s_site + half)
+        out[name] = float(cl.radius[under].min()) if under.any() else lumen_at(cl.points, cl.radius, s, s_site)[1]
+    return out
+
+
+def devices_fit(cl, dev, s_site, margin=0.0):
+    """Whether both crimped devices fit in the lumen under them with the margin (mm)."""
+    rmin = narrowest_under(cl, dev, s_site)
+    return rmin["stent"] >= dev.stent_radius + margin and rmin["balloon"] >= dev.balloon_radius + margin
+
+
+def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.05, extension=None,
+                 insertion=False):
     """Balloon centerline and device positions (see the module comment). PatientInputError when the
-    balloon does not fit on the centerline or the devices cannot clear the endothelium."""
+    balloon does not fit on the centerline or the devices cannot clear the endothelium (with
+    `insertion`: when the axis cannot be kept inside the lumen)."""
     s = cl.arc_length
     L = s[-1]
     src = cl.path
@@ -122,16 +149,17 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
     if dev.stent_length > dev.balloon_length:
         raise PatientInputError(f"stent: the stent ({dev.stent_length:g} mm) is longer than the balloon "
                                 f"({dev.balloon_length:g} mm): expected a stent that fits on the balloon")
-    # the devices must fit in the lumen at all: the narrowest station under each device
-    for name, half, R in (("stent", 0.5 * dev.stent_length, dev.stent_radius),
-                          ("balloon", 0.5 * dev.balloon_length, dev.balloon_radius)):
-        under = (s >= s_site - half) & (s <= s_site + half)
-        rmin = float(cl.radius[under].min()) if under.any() else lumen_at(cl.points, cl.radius, s, s_site)[1]
-        if rmin < R + margin:
+    # the devices must fit in the lumen at all (the narrowest station under each device), unless a
+    # virtual insertion opens the lesion first
+    narrowest = narrowest_under(cl, dev, s_site)
+    for name, R in (("stent", dev.stent_radius), ("balloon", dev.balloon_radius)):
+        rmin = narrowest[name]
+        if rmin < R + margin and not insertion:
             raise PatientInputError(
                 f"{src}: the crimped {name} (outer diameter {2 * R:.3f} mm) does not fit in the lumen "
                 f"(narrowest diameter {2 * rmin:.3f} mm under the {name}{f', margin {margin:g} mm' if margin else ''}): "
-                f"expected a lumen wider than the device, or a smaller {name}")
+                f"expected a lumen wider than the device, a smaller {name}, or the virtual insertion "
+                f"(patient.insertion.mode: auto)")
 
     inside = (s > s0) & (s < s1)
     p0, _ = lumen_at(cl.points, cl.radius, s, s0)
@@ -146,6 +174,9 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
     xs = np.linspace(s0, s1, max(int(math.ceil((s1 - s0) / sample)) + 1, 8))
     stent_zone = np.abs(xs - s_site) <= 0.5 * dev.stent_length
     R_dev = np.where(stent_zone, max(dev.stent_radius, dev.balloon_radius), dev.balloon_radius)
+    if insertion:  # only the axis must stay inside the lumen, well clear of the narrowest wall
+        R_dev = np.zeros_like(xs)
+        margin = 0.5 * narrowest["balloon"]
 
     rounds = 0
     while True:
@@ -158,7 +189,8 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
         if rounds == max_rounds:
             k = int(np.argmin(clear))
             raise PatientInputError(
-                f"{src}: cannot place the balloon centerline without the devices overlapping the endothelium "
+                f"{src}: cannot place the balloon centerline without "
+                f"{'its axis coming within ' + format(margin, '.3f') + ' mm of' if insertion else 'the devices overlapping'} the endothelium "
                 f"(after {rounds} rounds of weight adaptation, {-clear[k] + margin:.3f} mm too close at lumen arc length "
                 f"{xs[k]:.2f} mm, lumen diameter {2 * r[k]:.3f} mm there): expected a wider lumen or smaller devices")
         # double the weights of the lumen points near the stations that come too close
@@ -213,4 +245,5 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
         clearance_balloon=float(cb[kb]), clearance_stent=float(cs[ks]) if stent_zone.any() else float("nan"),
         clearance_where={"balloon_min_at_lumen_arc_length": float(xs[kb]),
                          "stent_min_at_lumen_arc_length": float(xs[ks])},
-        spline=spline_info, weight_rounds=rounds, max_weight=float(w[1:-1].max()) if len(w) > 2 else 1.0)
+        spline=spline_info, weight_rounds=rounds, max_weight=float(w[1:-1].max()) if len(w) > 2 else 1.0,
+        axis_clearance=float((r - dist).min()), insertion=bool(insertion))

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .artery_mesh import WallSpec, build_artery
+from .artery_mesh import WallSpec, build_artery, layer_radii
 from .centerline_csv import read_centerline_csv
 from .errors import PatientInputError
-from .placement import Device, place_device, stenosis_site
+from .placement import Device, devices_fit, place_device, stenosis_site
 
 # key: (kind, default); kind is the expected type; None default = required
 KEYS = {
@@ -32,6 +32,7 @@ KEYS = {
     "wall": ("map", {}),
     "mesh": ("map", {}),
     "balloon_spline": ("map", {}),
+    "insertion": ("map", {}),
 }
 WALL_KEYS = {"thickness": ("from_centerline_or_number", "from_centerline"),
              # thickness / outer diameter; see docs/user-guide.md "Patient-specific arteries" for the source
@@ -39,6 +40,14 @@ WALL_KEYS = {"thickness": ("from_centerline_or_number", "from_centerline"),
              "min_intima": ("positive", 0.05)}
 MESH_KEYS = {"size": ("positive", 0.8), "binary": ("bool", True), "loft_spacing": ("positive", 0.5)}
 SPLINE_KEYS = {"smoothing": ("positive", 4.0), "clearance": ("non_negative", 0.0)}
+# A lesion narrower than a crimped device: a rigid capsule along the balloon axis (contact.insertion)
+# opens the lumen to the devices' outer radius plus `clearance` during the blood-pressure phase, the
+# stent- and balloon-artery contacts switch on once it is open, and it retracts by t = 0 so that the
+# wall comes to rest on the devices (as catheter insertion is modelled by Zahedmanesh, Kelly and Lally,
+# J Biomech 43 (2010) 2126, and Mortier et al., Ann Biomed Eng 38 (2010) 88). clearance 0.065 mm and
+# penalty 300 N/mm^3: configs/stability/severe_stenosis_insertion.yaml, which runs with them.
+INSERTION_KEYS = {"mode": ("auto_or_off", "auto"), "clearance": ("positive", 0.065), "penalty": ("positive", 300.0)}
+INSERTION_CURVE = "insertion_tool"
 
 
 def _check_map(value, spec, where, scene_path):
@@ -73,6 +82,8 @@ def _check_map(value, spec, where, scene_path):
             bad = "auto or an arc length >= 0 (mm)"
         elif kind == "from_centerline_or_number" and not (v == "from_centerline" or (num and v > 0)):
             bad = "from_centerline (the CSV's wall column) or a positive thickness (mm)"
+        elif kind == "auto_or_off" and v not in ("auto", "off"):
+            bad = "auto (open a lesion narrower than the devices with the virtual insertion tool) or off"
         elif kind == "map" and not isinstance(v, dict):
             bad = "a map"
         if bad:
@@ -132,6 +143,55 @@ def device_of(scene, scene_path):
                   stent_length=float(stent_length), stent_radius=0.5 * float(crimped) + float(sec))
 
 
+def _curve_value(points, t):
+    ts = [float(p[0]) for p in points]
+    vs = [float(p[1]) for p in points]
+    return float(np.interp(t, ts, vs))
+
+
+def add_insertion(done, plc, dev, ins, scene_path):
+    """Completes `done` with the virtual insertion of a lesion narrower than the devices: the tool's
+    radius curve, contact.insertion and the artery contacts' switch-on time. Returns its report."""
+    time = done.get("time") if isinstance(done.get("time"), dict) else {}
+    start, end = time.get("start", 0.0), time.get("end")
+    tight = (f"the lesion (axis {plc.axis_clearance:.3f} mm from the endothelium at the narrowest) is narrower "
+             f"than the crimped devices (outer radius {max(dev.stent_radius, dev.balloon_radius):.3f} mm)")
+    if not (isinstance(start, (int, float)) and start < 0):
+        raise PatientInputError(f"{scene_path}: time.start: expected a phase before the inflation (time.start < 0 s, "
+                                f"e.g. -0.2) in which the virtual insertion tool opens the lumen: {tight}")
+    curves = done.get("load_curves") or {}
+    bp = done.get("balloon", {}).get("pressure", {})
+    bcurve = curves.get(bp.get("curve")) if isinstance(bp, dict) else None
+    probe = [start, 0.0] + [float(q[0]) for q in (bcurve or []) if start < float(q[0]) < 0.0]
+    if bcurve and any(abs(_curve_value(bcurve, t)) > 0 for t in probe):
+        raise PatientInputError(f"{scene_path}: load_curves.{bp.get('curve')}: expected no balloon pressure before "
+                                f"t = 0 (the virtual insertion opens the lumen then): {tight}")
+    contact = done.setdefault("contact", {})
+    if "insertion" in contact:  # the scene's own tool
+        return {"tool": "the scene's contact.insertion"}
+    if INSERTION_CURVE in curves:
+        raise PatientInputError(f"{scene_path}: load_curves.{INSERTION_CURVE}: expected no curve of this name "
+                                f"(the patient pipeline writes the insertion tool's radius under it)")
+    r0 = 0.9 * plc.axis_clearance  # inside the lumen everywhere along the axis
+    r_open = max(dev.stent_radius, dev.balloon_radius) + ins["clearance"]
+    T = -float(start)
+    t_open, t_on, t_hold = start + 0.5 * T, start + 0.55 * T, start + 0.6 * T
+    pts = [[float(start), r0], [t_open, r_open], [t_hold, r_open], [0.0, 0.0]]
+    if isinstance(end, (int, float)) and end > 0:
+        pts.append([float(end), 0.0])
+    curves[INSERTION_CURVE] = [[round(t, 9), round(v, 9)] for t, v in pts]
+    done["load_curves"] = curves
+    contact["insertion"] = {"axis": "balloon", "radius": {"value": 1.0, "curve": INSERTION_CURVE},
+                            "penalty": ins["penalty"]}
+    on = {}
+    for key in ("stent_artery", "balloon_artery"):
+        c = contact.get(key)
+        if isinstance(c, dict) and "from" not in c:
+            c["from"] = round(t_on, 9)
+            on[key] = c["from"]
+    return {"tool_radius_curve": curves[INSERTION_CURVE], "penalty": ins["penalty"], "contacts_from": on}
+
+
 def _write_points(path, pts, comment):
     with open(path, "w") as f:
         for ln in comment.splitlines():
@@ -147,6 +207,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     wall = _check_map(pat["wall"], WALL_KEYS, "patient.wall", scene_path)
     mesh = _check_map(pat["mesh"], MESH_KEYS, "patient.mesh", scene_path)
     spl = _check_map(pat["balloon_spline"], SPLINE_KEYS, "patient.balloon_spline", scene_path)
+    ins = _check_map(pat["insertion"], INSERTION_KEYS, "patient.insertion", scene_path)
     artery = _section(scene, ["artery"], scene_path, "an artery section {layers, blood_pressure, ...}")
     if not isinstance(artery, dict):
         raise PatientInputError(f"{scene_path}: artery: expected a map, got {artery!r}")
@@ -166,24 +227,14 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         wall_t = np.full(len(cl.radius), float(wall["thickness"]))
     s_site = stenosis_site(cl, None if pat["stenosis"] == "auto" else float(pat["stenosis"]),
                            where=f"{scene_path}: patient.stenosis")
-    plc = place_device(cl, dev, s_site, zeta=spl["smoothing"], margin=spl["clearance"])
+    insertion = ins["mode"] == "auto" and not devices_fit(cl, dev, s_site, margin=spl["clearance"])
+    plc = place_device(cl, dev, s_site, zeta=spl["smoothing"], margin=spl["clearance"], insertion=insertion)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     dev_file = out / "device_centerline.txt"
     lumen_file = out / "lumen_centerline.txt"
-    _write_points(dev_file, plc.points, f"Balloon and stent centerline fitted to {csv_path} (paper §2.4), x y z mm")
-    _write_points(lumen_file, cl.points, f"Lumen centerline of {csv_path}, x y z mm (fiber frames)")
-    shutil.copyfile(csv_path, out / "lumen.csv")  # the input as it was (radii for the report)
     spec = WallSpec(media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"],
                     min_intima=wall["min_intima"])
     msh = out / "artery.msh"
-    log(f"patient: stenosis at {s_site:.2f} mm (lumen diameter {2 * plc.site_radius:.3f} mm); balloon clears the "
-        f"endothelium by {plc.clearance_balloon:.3f} mm, the crimped stent by {plc.clearance_stent:.3f} mm; meshing "
-        f"the artery (size {mesh['size']:g} mm)")
-    info = build_artery(cl.points, cl.radius, wall_t, spec, mesh["size"], msh, binary=mesh["binary"],
-                        loft_spacing=mesh["loft_spacing"], where=str(csv_path), log=log)
-    log(f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs)")
-
     done = copy.deepcopy(scene)
     del done["patient"]
     _absolute_files(done, scene_path.parent)
@@ -193,10 +244,34 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     done["balloon"]["mesh"]["start"] = round(plc.balloon_start, 9)
     done["stent"]["generator"]["centerline"] = {"file": str(dev_file)}
     done["stent"]["generator"]["start"] = round(plc.stent_start, 9)
+    ins_report = add_insertion(done, plc, dev, ins, scene_path) if insertion else None
+    if insertion:
+        # the tool stretches the innermost layer most: elements larger than it is thick invert there
+        # (measured on the CI lesion, a 0.94 mm lumen in a 1.0 mm wall with a 0.63 mm intima: mesh.size
+        # 1.0 stops where the artery contacts switch on, 0.5 runs)
+        _, ti, _, _ = layer_radii(cl.radius, wall_t, spec, str(csv_path))
+        k = int(np.argmin(np.abs(cl.arc_length - s_site)))
+        if mesh["size"] > ti[k]:
+            log(f"patient: warning: patient.mesh.size {mesh['size']:g} mm is larger than the intima at the lesion "
+                f"({ti[k]:.3f} mm) that the virtual insertion stretches: elements may invert while it opens the "
+                f"lumen; a size below {ti[k]:.2f} mm is safer")
+    out.mkdir(parents=True, exist_ok=True)
+    _write_points(dev_file, plc.points, f"Balloon and stent centerline fitted to {csv_path} (paper §2.4), x y z mm")
+    _write_points(lumen_file, cl.points, f"Lumen centerline of {csv_path}, x y z mm (fiber frames)")
+    shutil.copyfile(csv_path, out / "lumen.csv")  # the input as it was (radii for the report)
+    fit = ("the crimped devices overlap the wall by up to "
+           f"{-min(plc.clearance_balloon, plc.clearance_stent):.3f} mm: a virtual insertion opens the lumen first"
+           if insertion else f"balloon clears the endothelium by {plc.clearance_balloon:.3f} mm, the crimped stent by "
+                             f"{plc.clearance_stent:.3f} mm")
+    log(f"patient: stenosis at {s_site:.2f} mm (lumen diameter {2 * plc.site_radius:.3f} mm); {fit}; meshing "
+        f"the artery (size {mesh['size']:g} mm)")
+    info = build_artery(cl.points, cl.radius, wall_t, spec, mesh["size"], msh, binary=mesh["binary"],
+                        loft_spacing=mesh["loft_spacing"], where=str(csv_path), log=log)
+    log(f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs)")
     report = {"centerline": str(csv_path), "points": int(len(cl.radius)),
               "lumen_length": float(cl.arc_length[-1]),
               "lumen_diameter_range": [float(2 * cl.radius.min()), float(2 * cl.radius.max())],
-              "placement": plc.report(), "artery_mesh": info,
+              "placement": plc.report(), "insertion": ins_report, "artery_mesh": info,
               "device": {"balloon_length": dev.balloon_length, "balloon_outer_diameter": 2 * dev.balloon_radius,
                          "stent_length": dev.stent_length, "stent_crimped_outer_diameter": 2 * dev.stent_radius}}
     with open(out / "placement.json", "w") as f:
@@ -215,7 +290,7 @@ def main(argv=None):
         with open(scene_path) as f:
             scene = yaml.safe_load(f)
         done, _ = prepare_scene(scene, scene_path, argv[1])
-    except PatientInputError as e:
+    except (PatientInputError, OSError, yaml.YAMLError) as e:
         print(f"prepare: error: {e}", file=sys.stderr)
         return 2
     with open(Path(argv[1]) / "scene.yaml", "w") as f:

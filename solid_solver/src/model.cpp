@@ -483,6 +483,7 @@ SolveReport SolidModel::solve(double loose_atol) {
   double res = norm(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
+  if (no.verbose && rank_ == 0) std::printf("    newton  0  |r| = %.3e\n", res0);
   auto converged = [&](double r, int it) { return r <= atol || (it > 0 && r <= no.rtol * res0); };
   rep.residual_history.push_back(res);
   std::vector<double> du_full, u_base;
@@ -599,9 +600,30 @@ SolveReport SolidModel::solve(double loose_atol) {
     }
     res = new_res;
     rep.residual_history.push_back(res);
-    if (no.verbose && rank_ == 0)
-      std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s\n", it + 1, res, alpha, int(lits),
-                  stale ? " (old factorization)" : "");
+    if (no.verbose) {
+      // where the residual is largest: which part of the model keeps Newton from converging
+      PetscInt at = -1;
+      PetscReal rmax = 0.0;
+      ANGIO_PETSC(VecNorm(r_, NORM_INFINITY, &rmax));
+      {
+        const PetscScalar* a;
+        PetscInt lo, hi;
+        ANGIO_PETSC(VecGetOwnershipRange(r_, &lo, &hi));
+        ANGIO_PETSC(VecGetArrayRead(r_, &a));
+        for (PetscInt i = lo; i < hi; ++i)
+          if (std::abs(a[i - lo]) == rmax) at = i;
+        ANGIO_PETSC(VecRestoreArrayRead(r_, &a));
+      }
+      PetscInt at_global = -1;
+      MPI_Allreduce(&at, &at_global, 1, MPIU_INT, MPI_MAX, comm_);
+      if (rank_ == 0) {
+        const int node = at_global >= 0 ? iperm_[at_global / 3] : -1;
+        const Vec3d x = node >= 0 ? position(node) : Vec3d::Zero();
+        std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)\n",
+                    it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1),
+                    x(2));
+      }
+    }
   }
   rep.total_seconds = MPI_Wtime() - t_start;
   rep.contact_seconds = contact_seconds_ - contact_start;
@@ -665,12 +687,32 @@ void SolidModel::commit() {
       element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, nullptr, &vh);
     }
   }
+  if (opt_.newton.extrapolate) {
+    if (time_ > committed_time_) {
+      u_before_.swap(u_committed_);
+      before_time_ = committed_time_;
+    } else {
+      u_before_.clear();  // start_at: no step to extrapolate along
+    }
+  }
   u_committed_ = u_;
   committed_time_ = time_;
 }
 void SolidModel::rollback() {
   u_ = u_committed_;
   pc_current_ = false;  // a rejected step restarts from a fresh factorization
+}
+
+bool SolidModel::predict() {
+  if (!opt_.newton.extrapolate) return false;
+  u_ = u_committed_;
+  if (u_before_.size() != u_.size() || !(committed_time_ > before_time_) || !(time_ > committed_time_)) return false;
+  const double f = (time_ - committed_time_) / (committed_time_ - before_time_);
+  for (size_t i = 0; i < u_.size(); ++i) u_[i] += f * (u_committed_[i] - u_before_[i]);
+  apply_dirichlet_values_();  // prescribed values exact at the new time: no lifting solve for them
+  if (assemble(r_, nullptr)) return true;  // collective: false on every rank if any element inverted
+  u_ = u_committed_;
+  return false;
 }
 
 void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume,

@@ -149,6 +149,7 @@ void SolidRunner::begin_step(int step, double time) {
   step_ = step;
   time_ = time;
   model_->set_time(time);
+  model_->predict();
 }
 
 participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply,

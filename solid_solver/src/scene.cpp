@@ -400,7 +400,8 @@ SolidScene read_solid_scene(const Node& root) {
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
       n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
-                     "damping_parts", "reuse_preconditioner", "tangent", "max_contraction", "continuation"});
+                     "damping_parts", "reuse_preconditioner", "tangent", "max_contraction", "continuation",
+                     "prediction"});
       auto& no = sc.options.newton;
       no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
       no.rtol = n->positive_or("rtol", no.rtol);
@@ -429,6 +430,8 @@ SolidScene read_solid_scene(const Node& root) {
       if (cont == 1)
         n->child("continuation").fail("0 (off) or the finest sub-increment as a fraction 1/N, N from 2 to 1024");
       no.continuation = int(cont);
+      no.extrapolate = n->choice_or("prediction", {"constant", "extrapolate"},
+                                    no.extrapolate ? "extrapolate" : "constant") == "extrapolate";
       if (!(no.max_contraction < 1.0)) n->child("max_contraction").fail("a contraction factor between 0 and 1 (exclusive)");
       if (n->optional("max_contraction") && !no.modified)
         n->child("max_contraction").fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");

@@ -5,8 +5,10 @@ the launcher: blood pressure and the start of the inflation (12 load steps) with
 materials, contact and solvers. Checks: exit 0; the placement meets eq. (3) (or the least-squares cubic)
 and clears the endothelium by the requested margin; every layer's stresses finite; the fiber frames
 written to solid.h5 orthonormal, axial along the lumen centerline tangent and radial away from it
-(consistency with the definition, paper §4.2.1); the lumen and stent summaries present. Then bad
-centerlines and devices through the launcher: exit 2 naming the file and the problem.
+(consistency with the definition, paper §4.2.1); the lumen and stent summaries present. A lesion
+narrower than the crimped stent (0.935 mm lumen) through the virtual insertion, to t = 0: the lumen
+opened and the wall resting on the stent once the tool is gone. Then bad centerlines and devices
+through the launcher: exit 2 naming the file and the problem.
 Usage: test_patient_short.py BIN_DIR
 """
 import json
@@ -116,6 +118,31 @@ with tempfile.TemporaryDirectory(prefix="patient-short-") as tmp:
         rad = c - foot[np.arange(len(c)), k]
         check((np.einsum("ij,ij->i", Fr, rad) > 0).all(), "radial frame points away from the centerline")
 
+    # a lesion narrower than the crimped stent (0.935 mm lumen against 1.27 mm): the virtual insertion
+    # opens it before the inflation and the wall comes to rest on the stent (to t = 0, the tool gone)
+    tight_r = 0.85 * (1 - 0.45 * np.exp(-((arc_length(pts) - 4.0) / 1.2) ** 2))
+    write_centerline_csv(Path(tmp) / "tight.csv", pts, tight_r, wall)
+
+    def tight(s):
+        s["time"] = {"start": -0.2, "end": 0.0, "steps": 10, "min_step": 0.0005}
+        s["patient"]["mesh"]["size"] = 0.5  # 1.0 (one tet10 through the intima) inverts elements
+        s["solid"]["ranks"] = 2
+
+    p = launch(tmp, scene_for("tight.csv", t=tight), "tight")
+    print(p.stdout[-2000:], p.stderr[-2000:])
+    check(p.returncode == 0, f"the tight lesion runs with the virtual insertion (exit {p.returncode})")
+    if p.returncode == 0:
+        run = Path(tmp) / "run-tight"
+        plc = json.loads((run / "geometry" / "placement.json").read_text())
+        check(plc["placement"]["insertion"] and plc["placement"]["clearance"]["stent"] < 0,
+              f"placed by insertion, the crimped stent overlapping the wall ({plc['placement']['clearance']})")
+        pre = json.loads((run / "results.json").read_text())["artery"]["phases"]["prestressed"]
+        lumen = pre["lumen_diameter_min_all_stations"]
+        check(lumen > 2 * tight_r.min() + 0.2, f"lumen opened from {2 * tight_r.min():.3f} to {lumen:.3f} mm")
+        force = pre["artery_contact_force"]
+        check(force["stent"] > 0 and force["insertion"] == 0,
+              f"at t = 0 the tool is gone and the wall rests on the stent ({force})")
+
     # bad input: exit 2 naming the file and the problem (before anything is meshed)
     bad = [
         ("three points", lambda: write_centerline_csv(Path(tmp) / "b.csv", pts[:3], r[:3], wall[:3]), {},
@@ -127,7 +154,12 @@ with tempfile.TemporaryDirectory(prefix="patient-short-") as tmp:
         ("balloon longer than the centerline", lambda: write_centerline_csv(Path(tmp) / "b.csv", pts, r, wall),
          {"b": lambda s: s["balloon"]["mesh"].update(length=12.0)}, "reaches beyond the centerline"),
         ("stent does not fit", lambda: write_centerline_csv(Path(tmp) / "b.csv", pts, r, wall),
-         {"s": lambda s: s["stent"]["generator"].update(crimped_diameter=1.6)}, "does not fit in the lumen"),
+         {"s": lambda s: s["stent"]["generator"].update(crimped_diameter=1.6),
+          "i": lambda s: s["patient"].update(insertion={"mode": "off"})}, "does not fit in the lumen"),
+        ("tight lesion without a phase before the inflation",
+         lambda: write_centerline_csv(Path(tmp) / "b.csv", pts, r, wall),
+         {"s": lambda s: s["stent"]["generator"].update(crimped_diameter=1.6),
+          "t": lambda s: s["time"].update(start=0.0)}, "time.start"),
         ("unknown patient key", lambda: write_centerline_csv(Path(tmp) / "b.csv", pts, r, wall),
          {"k": lambda s: s["patient"].update(stenosys="auto")}, "did you mean `stenosis`"),
     ]

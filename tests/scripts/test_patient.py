@@ -17,7 +17,9 @@ sys.path.insert(0, str(ROOT / "scripts"))
 from patient.artery_mesh import TET10_EDGES, WallSpec, build_artery, layer_radii  # noqa: E402
 from patient.centerline_csv import read_centerline_csv, write_centerline_csv  # noqa: E402
 from patient.errors import PatientInputError  # noqa: E402
-from patient.placement import Device, nearest_on_polyline, place_device, stenosis_site  # noqa: E402
+from patient.placement import (Device, devices_fit, narrowest_under, nearest_on_polyline, place_device,  # noqa: E402
+                               stenosis_site)
+from patient.prepare import add_insertion  # noqa: E402
 
 
 def arc(n=60, length=12.0, bend=20.0, r0=0.9, stenosis=0.25, noise=0.0, seed=1, wiggle=0.0):
@@ -144,6 +146,67 @@ class Placement(unittest.TestCase):
             place_device(cl, Device(8.0, 0.3, 9.0, 0.4), stenosis_site(cl))
         with self.assertRaisesRegex(PatientInputError, "within the centerline"):
             stenosis_site(cl, 100.0)
+
+
+class Insertion(unittest.TestCase):
+    """A lesion narrower than the crimped devices: placed all the same with the
+    axis kept inside the lumen, and the scene completed with the virtual insertion tool."""
+    DEV = Device(balloon_length=8.0, balloon_radius=0.49, stent_length=6.0, stent_radius=0.635)
+
+    def placement(self):
+        cl = Placement.centerline(self, r0=0.8, stenosis=0.45, noise=0.005)  # lumen 0.88 mm at the site
+        s_site = stenosis_site(cl)
+        self.assertFalse(devices_fit(cl, self.DEV, s_site))
+        return cl, place_device(cl, self.DEV, s_site, insertion=True)
+
+    def test_axis_inside_the_lumen(self):
+        cl, plc = self.placement()
+        self.assertTrue(plc.insertion)
+        self.assertLess(plc.clearance_stent, 0.0)  # the crimped stent overlaps the wall
+        # the axis clearance recomputed from the written centerline over the balloon
+        sig = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(plc.points, axis=0), axis=1))])
+        on = (sig >= plc.balloon_start) & (sig <= plc.balloon_start + self.DEV.balloon_length)
+        d, r = nearest_on_polyline(cl.points, cl.radius, plc.points[on])
+        narrowest = narrowest_under(cl, self.DEV, stenosis_site(cl))["balloon"]
+        self.assertGreaterEqual((r - d).min(), 0.5 * narrowest - 1e-3)
+        self.assertAlmostEqual(plc.axis_clearance, (r - d).min(), delta=2e-3)
+        with self.assertRaisesRegex(PatientInputError, "patient.insertion.mode: auto"):
+            place_device(cl, self.DEV, stenosis_site(cl))
+
+    def scene(self):
+        return {"time": {"start": -0.2, "end": 2.0, "steps": 110},
+                "load_curves": {"balloon": [[-0.2, 0.0], [0.0, 0.0], [1.0, 1.317], [2.0, 0.0]]},
+                "balloon": {"pressure": {"value": 1.0, "curve": "balloon"}},
+                "contact": {"stent_balloon": {"penalty": 10.0}, "stent_artery": {"penalty": 10.0},
+                            "balloon_artery": {"penalty": 50.0}}}
+
+    def test_tool_opens_before_the_inflation(self):
+        _, plc = self.placement()
+        done = self.scene()
+        rep = add_insertion(done, plc, self.DEV, {"clearance": 0.065, "penalty": 300.0}, "s.yaml")
+        curve = np.array(done["load_curves"]["insertion_tool"])
+        self.assertEqual(done["contact"]["insertion"]["radius"]["curve"], "insertion_tool")
+        self.assertEqual(done["contact"]["insertion"]["axis"], "balloon")
+        self.assertLess(curve[0, 1], plc.axis_clearance)             # starts inside the lumen
+        self.assertAlmostEqual(curve[:, 1].max(), 0.635 + 0.065)     # opens to the stent + clearance
+        self.assertEqual(np.interp(0.0, curve[:, 0], curve[:, 1]), 0.0)  # gone when the inflation starts
+        t_open = curve[np.argmax(curve[:, 1]), 0]
+        t_close = curve[curve[:, 1] == curve[:, 1].max(), 0].max()
+        for key in ("stent_artery", "balloon_artery"):  # the artery contacts switch on while it is open
+            self.assertTrue(t_open <= done["contact"][key]["from"] <= t_close, (key, done["contact"][key]))
+            self.assertEqual(rep["contacts_from"][key], done["contact"][key]["from"])
+        self.assertNotIn("from", done["contact"]["stent_balloon"])
+
+    def test_refused_without_a_phase_before_the_inflation(self):
+        _, plc = self.placement()
+        done = self.scene()
+        done["time"]["start"] = 0.0
+        with self.assertRaisesRegex(PatientInputError, "time.start"):
+            add_insertion(done, plc, self.DEV, {"clearance": 0.065, "penalty": 300.0}, "s.yaml")
+        done = self.scene()
+        done["load_curves"]["balloon"] = [[-0.2, 0.0], [1.0, 1.317]]
+        with self.assertRaisesRegex(PatientInputError, "no balloon pressure before"):
+            add_insertion(done, plc, self.DEV, {"clearance": 0.065, "penalty": 300.0}, "s.yaml")
 
 
 class ArteryMesh(unittest.TestCase):

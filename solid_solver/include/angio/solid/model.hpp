@@ -78,6 +78,15 @@ struct NewtonOptions {
   // (λ = ½ and 1, one halving): every solve carried in the generic artery needed at most one
   // halving, and a hopeless step (a stent inside the wall) pays at most two extra solves per cut.
   int continuation = 4;
+  // First iterate of a load step: the committed state (false), or the committed state moved on by the
+  // last step's motion scaled to this step's increment, u_n + (Δt/Δt_prev)(u_n − u_n−1) (true; a
+  // linear extrapolation in the pseudo-time, as the coupler's `prediction: extrapolate` for the
+  // interface). A steadily unfolding balloon starts each step close to its end instead of a whole
+  // increment away; a predicted state with an inverted element falls back to the committed one.
+  // Off by default: it saves 11 % of the straight free expansion's Newton iterations, but in the
+  // generic artery's indentation phase, where Newton is limited by the stiffening wall at the stent
+  // ends rather than by the distance from the start, it cost a cut step (solid_solver/README.md).
+  bool extrapolate = false;
 };
 
 struct ModelOptions {
@@ -162,6 +171,10 @@ class SolidModel {
   // advanced over Δt = t − t_committed from the committed one.
   void commit();
   void rollback();  // back to the last committed state (displacement; the viscous history is only ever committed)
+  // First iterate of the step at the current time (newton.extrapolate; collective): the committed
+  // state extrapolated along the last committed step, or the committed state itself where there is
+  // no earlier step or the extrapolated state is invalid. Returns whether it extrapolated.
+  bool predict();
   // The whole displacement (new numbering, every rank): a solve's starting point, kept and restored
   // by a continuation within the step (rollback() returns to the committed state instead).
   const std::vector<double>& state() const { return u_; }
@@ -225,6 +238,8 @@ class SolidModel {
   double time_ = 0.0, committed_time_ = 0.0;
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
+  std::vector<double> u_before_;          // the commit before u_committed_ (newton.extrapolate)
+  double before_time_ = 0.0;
   Vec damping_diag_ = nullptr;            // η·V_a per owned dof (NewtonOptions::damping); null when off
   Vec damping_tangent_ = nullptr;         // η·V_a/Δt, refilled per assembly (no allocation in Newton)
   double damping_(Vec r, Mat K);

@@ -99,6 +99,7 @@ class SolidRunner : public participant::SolidParticipant {
   void clear_contact_reports() { contact_reports_.clear(); }
   const std::vector<StepSummary>& history() const { return history_; }
   const SolveReport& last_report() const { return last_; }
+  const SolveTotals& totals() const { return totals_; }
   // Balloon outer diameters (mm) at mid-length and both ends for the current state (all ranks).
   void balloon_diameters(double& mid, double& end0, double& end1) const;
 
