@@ -12,6 +12,7 @@
 #include "angio/participant/standalone.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
+#include "free_balloon_scene.hpp"
 #include "mpi_test.hpp"
 
 using namespace angio::solid;
@@ -19,13 +20,7 @@ using namespace angio::solid;
 namespace {
 
 SolidScene balloon(int steps, int continuation) {
-  const auto root = angio::scene::load_scene(std::string(ANGIO_CONFIGS_DIR) + "/solid_free_balloon.yaml");
-  SolidScene sc = read_solid_scene(root);
-  sc.time.end = 1.0;  // inflation only: 0 -> 13 atm
-  sc.time.steps = steps;
-  sc.time.max_cuts = 0;  // a failed step ends the run: the continuation must carry it
-  sc.options.petsc_options = "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps";
-  sc.options.newton.atol = 1e-8;
+  SolidScene sc = free_balloon_inflation(steps);  // no cuts: the continuation must carry a failed step
   sc.options.newton.max_iterations = 12;
   sc.options.newton.continuation = continuation;
   return sc;

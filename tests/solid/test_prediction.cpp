@@ -13,6 +13,7 @@
 #include "angio/participant/standalone.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
+#include "free_balloon_scene.hpp"
 #include "mpi_test.hpp"
 
 using namespace angio::solid;
@@ -20,13 +21,7 @@ using namespace angio::solid;
 namespace {
 
 SolidScene balloon(bool extrapolate) {
-  const auto root = angio::scene::load_scene(std::string(ANGIO_CONFIGS_DIR) + "/solid_free_balloon.yaml");
-  SolidScene sc = read_solid_scene(root);
-  sc.time.end = 1.0;  // inflation only: 0 -> 13 atm
-  sc.time.steps = 20;
-  sc.time.max_cuts = 0;
-  sc.options.petsc_options = "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps";
-  sc.options.newton.atol = 1e-8;
+  SolidScene sc = free_balloon_inflation(20);
   sc.options.newton.continuation = 0;
   sc.options.newton.extrapolate = extrapolate;
   return sc;
