@@ -252,6 +252,15 @@ void BeamModel::set_state(const std::vector<Vec3>& x, const std::vector<Quat>& R
   R_ = R;
 }
 
+void BeamModel::start_from(double t, const std::vector<Vec3>& x, const std::vector<Quat>& R,
+                           const std::vector<PlasticState>& plastic) {
+  xc_ = x_ = x;
+  Rc_ = R_ = R;
+  mp_committed_ = mp_trial_ = plastic;
+  set_time(t);
+  xc_ = x_;
+}
+
 void BeamModel::assemble(SpMat* K, Eigen::VectorXd& r) {
   Eigen::VectorXd rg;
   assemble_global(K, rg);

@@ -15,6 +15,10 @@ namespace angio::beam {
 
 BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string& run_dir)
     : scene_(std::move(scene)), run_dir_(run_dir) {
+  if (scene_.initial_state) {
+    apply_beam_state(*scene_.model, *scene_.initial_state);
+    LOG_INFO("beam: continuing from " << scene_.initial_state->path << " at t = " << scene_.initial_state->time << " s");
+  }
   if (!run_dir_.empty()) {
     out_ = std::make_unique<BeamOutput>(run_dir_ + "/beam");
     out_->write_step(*scene_.model, 0, scene_.time.start);  // reference state
@@ -169,9 +173,10 @@ void BeamSolverParticipant::end_step(bool accept) {
   stent_measures(r, false);
   records_.push_back(r);
   last_written_ = false;
-  if (out_ && (accepted_ % std::max(1, scene_.output_every) == 0)) {
+  if (out_ && (accepted_ % std::max(1, scene_.output.every) == 0)) {
     out_->write_step(m, step_, time_);
     last_written_ = true;
+    write_state_();
   }
   LOG_INFO("beam step " << step_ << " t = " << time_ << " s: " << r.iterations << " it, |r| = "
                         << std::scientific << std::setprecision(2) << r.residual << std::defaultfloat
@@ -180,12 +185,19 @@ void BeamSolverParticipant::end_step(bool accept) {
                         << r.wall_seconds << " s");
 }
 
+void BeamSolverParticipant::write_state_() {
+  if (!out_ || !scene_.output.state || state_step_ == accepted_) return;
+  write_beam_state(*scene_.model, run_dir_ + "/beam/state.h5", accepted_);
+  state_step_ = accepted_;
+}
+
 void BeamSolverParticipant::finish() {
   if (finished_) return;
   finished_ = true;
   BeamModel& m = *scene_.model;
   if (out_) {
     if (!last_written_ && !records_.empty()) out_->write_step(m, records_.back().step, records_.back().time);
+    write_state_();
     out_->close();
     const bool complete = !records_.empty() && records_.back().time >= scene_.time.end - 1e-12;
     write_summary(run_dir_ + "/beam/summary.json", m, records_, scene_.generated_stent,

@@ -125,14 +125,12 @@ BeamScene beam_scene_from(const Node& root) {
   BeamScene bs;
   bs.file = root.file();
   bs.time = scene::time_settings(root);
-  if (auto out = root.optional("output")) {
-    if (out->has("every")) bs.output_every = static_cast<int>(out->integer("every", 1));
-  }
+  bs.output = scene::output_settings(root);
   const scene::LoadCurves curves = scene::load_curves(root);
   const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
   st.check_keys({"material", "plasticity", "section", "generator", "nodes", "elements", "lines",
                  "up", "axis", "fixation", "supports", "loads", "solver", "contact", "triads",
-                 "element"});
+                 "element", "initial_state"});
   bs.model = std::make_unique<BeamModel>();
   BeamModel& m = *bs.model;
   const int sec = m.add_section(read_section(st));
@@ -338,6 +336,17 @@ BeamScene beam_scene_from(const Node& root) {
     m.finalize();
   } catch (const std::invalid_argument& e) {
     st.fail(std::string("a consistent model (") + e.what() + ")");
+  }
+  if (auto is = st.optional("initial_state")) {  // continue from an earlier run's committed stent
+    is->check_keys({"file"});
+    const Node file = is->child("file", "the path of a beam state file (<run>/beam/state.h5 of an earlier run)");
+    try {
+      bs.initial_state = read_beam_state(scene::resolve_path(*is, file.as_string()));
+      check_beam_state(*bs.initial_state, m);
+    } catch (const std::runtime_error& e) {
+      file.fail(std::string("a beam state file of this scene's stent: ") + e.what());
+    }
+    scene::require_start_at(root, bs.time, bs.initial_state->time, bs.initial_state->path);
   }
   return bs;
 }

@@ -36,6 +36,21 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
   auto scheme = make_interface_scheme(settings.scheme, n);
 
   double first_residual_force = 0.0;  // |w r_0| of the last accepted step (N): iteration 0's solid tolerance
+  if (settings.synchronize) {
+    // A run continued from state files: the contact planes (loads) of the committed state are not in
+    // any file; the solid recomputes them at the beam's committed positions at the start time,
+    // without a Newton iteration (the largest tolerance: the committed state is an equilibrium) and
+    // without committing, so the first step starts from them instead of from a stent without contact.
+    const auto points = beam.sample_points();
+    participant::ContactReply reply;
+    solid.begin_step(stepper.step() - 1, time.start);
+    const participant::SolveStats ss = solid.solve(points, reply, std::numeric_limits<double>::max());
+    solid.end_step(false);
+    if (!ss.converged || reply.line_loads.size() != n)
+      throw std::runtime_error("the solid's contact state at the start time could not be evaluated: " + ss.message);
+    scheme->seed(points, reply);
+    LOG_INFO("interface state recomputed at t = " << time.start << " s from the participants' committed states");
+  }
   auto step_start = Clock::now();
   while (!stepper.finished()) {
     StepReport rep;

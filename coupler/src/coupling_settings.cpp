@@ -8,6 +8,8 @@ namespace angio::coupler {
 
 CouplingSettings coupling_settings(const scene::Node& root) {
   CouplingSettings s;
+  for (const char* part : {"stent", "solid"})
+    if (auto p = root.optional(part); p && p->is_map() && p->has("initial_state")) s.synchronize = true;
   auto c = root.optional("coupling");
   if (!c) return s;
   c->check_keys({"scheme", "acceleration", "initial_relaxation", "max_relaxation", "max_iterations",

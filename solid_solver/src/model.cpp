@@ -306,6 +306,44 @@ void SolidModel::set_displacement(const std::vector<Vec3d>& u) {
     for (int k = 0; k < 3; ++k) u_[dof(int(n), k)] = u[n](k);
 }
 
+Vec3d SolidModel::committed_displacement(int node) const {
+  const int i = 3 * perm_[node];
+  return Vec3d(u_committed_[i], u_committed_[i + 1], u_committed_[i + 2]);
+}
+
+bool SolidModel::before_state(double& time, std::vector<Vec3d>* u) const {
+  if (u_before_.size() != u_committed_.size()) return false;
+  time = before_time_;
+  if (u) {
+    u->resize(mesh_.X.size());
+    for (size_t n = 0; n < mesh_.X.size(); ++n)
+      for (int k = 0; k < 3; ++k) (*u)[n](k) = u_before_[dof(int(n), k)];
+  }
+  return true;
+}
+
+SolidModel::ViscousState SolidModel::viscous_state(size_t i) {
+  if (visc_offset_[i] < 0) return {};
+  const auto& el = mesh_.elements[local_elements_[i]];
+  return {int(volume_rule(el.type).size()), visc_Q_.data() + visc_offset_[i], visc_S_.data() + visc_offset_[i]};
+}
+
+void SolidModel::start_from(double t, const std::vector<Vec3d>& u, const std::vector<Vec3d>& u_before,
+                            double before_time) {
+  set_displacement(u);
+  time_ = committed_time_ = t;
+  apply_dirichlet_values_();
+  u_committed_ = u_;
+  u_before_.clear();
+  if (!u_before.empty()) {
+    u_before_.resize(u_.size());
+    for (size_t n = 0; n < mesh_.X.size(); ++n)
+      for (int k = 0; k < 3; ++k) u_before_[dof(int(n), k)] = u_before[n](k);
+    before_time_ = before_time;
+  }
+  pc_current_ = false;
+}
+
 void SolidModel::gather_(Vec v, std::vector<double>& full) {
   ANGIO_PETSC(VecScatterBegin(scatter_, v, full_, INSERT_VALUES, SCATTER_FORWARD));
   ANGIO_PETSC(VecScatterEnd(scatter_, v, full_, INSERT_VALUES, SCATTER_FORWARD));
@@ -633,10 +671,10 @@ SolveReport SolidModel::solve(double loose_atol) {
 double SolidModel::damping_(Vec r, Mat K) {
   // f_a = η·V_a·(u_a − u_a,committed)/Δt on the owned dofs, added to r (if given); its tangent η·V_a/Δt
   // on the diagonal of K (if given). Returns the global norm of f.
+  // No time since the last commit (an evaluation of the committed state itself, as the coupler's
+  // synchronization of a continued run): no rate, no damping force.
   const double dt = time_ - committed_time_;
-  if (!(dt > 0.0))
-    throw std::logic_error("solid damping needs a time increment since the last commit (t = " + std::to_string(time_) +
-                           ", committed t = " + std::to_string(committed_time_) + ")");
+  if (!(dt > 0.0)) return 0.0;
   const PetscScalar* d;
   PetscScalar *rr = nullptr, *kk = nullptr;
   ANGIO_PETSC(VecGetArrayRead(damping_diag_, &d));

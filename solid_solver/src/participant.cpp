@@ -12,27 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include "angio/common/log.hpp"
+#include "angio/solid/gather.hpp"
 
 namespace angio::solid {
-
-namespace {
-// The concatenation of every rank's `mine` on rank 0 (rank order); empty on the other ranks.
-std::vector<double> gather_on_root(MPI_Comm comm, const std::vector<double>& mine) {
-  int size = 1, rank = 0;
-  MPI_Comm_size(comm, &size);
-  MPI_Comm_rank(comm, &rank);
-  const int count = int(mine.size());
-  std::vector<int> counts(size), displs(size, 0);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  std::vector<double> all;
-  if (rank == 0) {
-    for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
-    all.resize(displs.back() + counts.back());
-  }
-  MPI_Gatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm);
-  return all;
-}
-}  // namespace
 
 SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run_dir)
     : comm_(comm), scene_(std::move(scene)) {
@@ -90,6 +72,15 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
   time_ = scene_.time.start;
   ok_time_ = committed_ok_time_ = time_;
   model_->start_at(time_);
+  if (scene_.initial_state) {  // continue from an earlier run's committed state (time.start is its time)
+    apply_state(*model_, *scene_.initial_state, scene_.initial_parts);
+    if (rank_ == 0) {
+      std::string parts;
+      for (const auto& p : scene_.initial_parts) parts += " " + p;
+      LOG_INFO("solid: continuing from " << scene_.initial_state->path << " at t = " << time_ << " s, parts:" << parts);
+    }
+    scene_.initial_state.reset();  // its copy of the parts is not needed any more
+  }
   if (!run_dir.empty()) {
     dir_ = run_dir + "/solid";
     writer_ = std::make_unique<FieldWriter>(*model_, dir_);
@@ -251,6 +242,7 @@ void SolidRunner::end_step(bool accept) {
   model_->commit();
   ++committed_;
   record_and_write_(committed_, time_);
+  if (committed_ % scene_.output.every == 0) write_state_();
   if (rank_ == 0) {
     const auto& h = history_.back();
     std::ostringstream os;
@@ -431,7 +423,7 @@ void SolidRunner::record_and_write_(int step, double time) {
     s.solve_seconds = last_.total_seconds;
   }
   history_.push_back(s);
-  if (writer_ && (step % scene_.output_every == 0 || step == 0)) {
+  if (writer_ && (step % scene_.output.every == 0 || step == 0)) {
     std::vector<std::pair<std::string, const std::vector<double>*>> nodal;
     if (!contact_pressure.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);
     std::vector<std::vector<double>> fields(recovery_->num_blocks());
@@ -563,10 +555,17 @@ void SolidRunner::write_summary_json_() const {
   std::rename(tmp.c_str(), (dir_ + "/summary.json").c_str());
 }
 
+void SolidRunner::write_state_() {
+  if (!writer_ || !scene_.output.state || state_step_ == committed_) return;
+  write_state_file(*model_, dir_ + "/state.h5", committed_);
+  state_step_ = committed_;
+}
+
 void SolidRunner::finish() {
   if (finished_) return;
   finished_ = true;
   if (writer_ && rank_ == 0) write_summary_json_();  // the timing of the solves after the last commit
+  write_state_();
   if (writer_) writer_->close();
 }
 

@@ -1,5 +1,6 @@
 #include "angio/solid/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -276,13 +277,45 @@ void read_fixed(const Node& part, const std::string& prefix, const Mesh& m, std:
   }
 }
 
+// solid.initial_state: {file, parts}: the parts' committed state from a state file of an earlier run.
+void read_initial_state(const Node& is, const Node& root, SolidScene& sc) {
+  is.check_keys({"file", "parts"});
+  const Node file = is.child("file", "the path of a solid state file (<run>/solid/state.h5 of an earlier run)");
+  const std::string path = scene::resolve_path(is, file.as_string());
+  StateFile state;
+  try {
+    state = read_state_file(path);
+  } catch (const StateFileError& e) {
+    file.fail(std::string("a solid state file: ") + e.what());
+  }
+  std::vector<std::string> parts;
+  if (auto p = is.optional("parts")) {
+    if (!p->is_sequence() || p->size() == 0) p->fail("a list of parts of the state file");
+    for (size_t i = 0; i < p->size(); ++i) {
+      const std::string name = p->at(i).as_string();
+      if (std::find(parts.begin(), parts.end(), name) != parts.end()) p->at(i).fail("each part once");
+      parts.push_back(name);
+    }
+  } else {
+    for (const auto& ps : state.parts) parts.push_back(ps.name);
+  }
+  try {
+    check_state(state, sc.mesh, parts, sc.materials);
+  } catch (const StateFileError& e) {
+    (is.has("parts") ? is.child("parts") : file).fail(std::string("parts that fit this scene's mesh: ") + e.what());
+  }
+  scene::require_start_at(root, sc.time, state.time, path);
+  sc.initial_state = std::move(state);
+  sc.initial_parts = std::move(parts);
+}
+
 }  // namespace
 
 SolidScene read_solid_scene(const Node& root) {
   SolidScene sc;
   sc.time = scene::time_settings(root);
   const auto curves = scene::load_curves(root);
-  if (auto out = root.optional("output")) sc.output_every = int(out->integer_or("every", 1, 1));
+  sc.output = scene::output_settings(root);
 
   if (auto b = root.optional("balloon")) {
     sc.has_balloon = true;
@@ -393,7 +426,7 @@ SolidScene read_solid_scene(const Node& root) {
         root.fail("unique block names (balloon and artery both have a block '" + sc.mesh.blocks[i].name + "')");
 
   if (auto s = root.optional("solid")) {
-    s->check_keys({"ranks", "partitioner", "petsc_options", "newton"});
+    s->check_keys({"ranks", "partitioner", "petsc_options", "newton", "initial_state"});
     sc.ranks = int(s->integer_or("ranks", 0, 1));
     sc.options.partitioner = s->choice_or("partitioner", {"contiguous", "ptscotch", "parmetis", "average", "square"},
                                           "contiguous");
@@ -439,6 +472,8 @@ SolidScene read_solid_scene(const Node& root) {
         n->child("reuse_preconditioner").fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
     }
   }
+  if (auto s = root.optional("solid"))
+    if (auto is = s->optional("initial_state")) read_initial_state(*is, root, sc);
   // The Newton stops at ||r|| <= atol whatever the load; an atol of the order of the loads' own norm
   // accepts a loaded step before anything moves (found by the Newton-tolerance ladder of scripts/work_precision.py:
   // atol 1 N on the straight scene, the balloon never inflated and the run ended "ok").

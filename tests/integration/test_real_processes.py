@@ -9,8 +9,14 @@
        the coupler sends equals the recorded one, relative tolerance 1e-9);
    (b) the real beam_solver driven by the recorded requests reproduces the recorded replies;
    (c) the same for the real solid_solver on 2 MPI ranks.
+3. A run continued from the state files of the first step (stent.initial_state, solid.initial_state)
+   ends where the uninterrupted run ends: the stent's final positions agree to 1 % of their motion
+   over the second step (the coupler recomputes the contact planes of the committed state before it
+   starts; without them the stent would spring back in its first iteration). A state of another mesh
+   is refused by --check with exit 2 naming the key.
 """
 import json
+import math
 import os
 import secrets
 import struct
@@ -52,6 +58,40 @@ with tempfile.TemporaryDirectory() as tmp:
         check(summ["status"] == "ok", "coupling summary status ok")
         check((tmp / "real" / "beam" / "summary.json").is_file(), "beam summary written")
         check((tmp / "real" / "solid" / "summary.json").is_file(), "solid summary written")
+
+        # 3. continued from the state files of the first step
+        import yaml
+        base = yaml.safe_load(SCENE.read_text())
+        def variant(name, time, states=None, n_circ=None):
+            s = json.loads(json.dumps(base))
+            s["time"] = time
+            if states:
+                s["stent"]["initial_state"] = {"file": str(states / "beam" / "state.h5")}
+                s["solid"]["initial_state"] = {"file": str(states / "solid" / "state.h5")}
+            if n_circ:
+                s["balloon"]["mesh"]["n_circ"] = n_circ
+            path = tmp / f"{name}.yaml"
+            path.write_text(yaml.safe_dump(s))
+            return path
+        first = variant("first", {"end": 0.5, "steps": 1})
+        r = run(LAUNCH + [str(first), "--run-dir", str(tmp / "first"), "--build-dir", str(BIN.parent), "--timeout", "120"])
+        check(r.returncode == 0 and (tmp / "first" / "solid" / "state.h5").is_file()
+              and (tmp / "first" / "beam" / "state.h5").is_file(), f"first step writes both state files (rc {r.returncode})")
+        second = variant("second", {"start": 0.5, "end": 1.0, "steps": 1}, tmp / "first")
+        r = run(LAUNCH + [str(second), "--run-dir", str(tmp / "second"), "--build-dir", str(BIN.parent), "--timeout", "120"])
+        check(r.returncode == 0, f"the continued run exits 0 (rc {r.returncode})\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
+        if r.returncode == 0:
+            log = (tmp / "second" / "coupler.log").read_text()
+            check("interface state recomputed at t = 0.5 s" in log, "the coupler recomputes the interface state at t = 0.5 s")
+            final = {k: json.loads((tmp / k / "beam" / "summary.json").read_text())["final_positions"] for k in ("real", "first", "second")}
+            dist = lambda a, b: max(math.dist(p, q) for p, q in zip(a, b))
+            motion, diff = dist(final["first"], final["real"]), dist(final["second"], final["real"])
+            print(f"     stent motion over the second step {motion:.4e} mm, continued - uninterrupted {diff:.3e} mm")
+            check(motion > 1e-3 and diff < 0.01 * motion, "the continued run ends where the uninterrupted run ends (1 % of the step's motion)")
+        other = variant("other_mesh", {"start": 0.5, "end": 1.0, "steps": 1}, tmp / "first", n_circ=16)
+        r = run(LAUNCH + [str(other), "--check", "--build-dir", str(BIN.parent)])
+        check(r.returncode == 2 and "solid.initial_state" in r.stdout + r.stderr,
+              f"a state of another mesh: --check exits 2 naming solid.initial_state (rc {r.returncode})\n{r.stderr[-800:]}")
 
     if REC.is_file():
         # The recorded run id (header: 8-byte magic, u32 format, u32 length + id): the real

@@ -1,6 +1,8 @@
 #include "angio/scene/load_curve.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace angio::scene {
@@ -72,6 +74,15 @@ ScaledCurve scaled_curve(const Node& parent, const std::string& key, const LoadC
   s.value = n.number_or("value", 1.0);
   s.curve = curve_ref(n, "curve", curves);
   return s;
+}
+
+void require_start_at(const Node& root, const TimeSettings& time, double state_time, const std::string& state) {
+  if (std::abs(time.start - state_time) <= 1e-9 * std::max(1.0, std::abs(state_time))) return;
+  std::ostringstream m;
+  m << "the state's time " << state_time << " s (" << state << "), where the run continues from";
+  const auto t = root.optional("time");
+  if (t && t->has("start")) t->child("start").fail(m.str());
+  root.fail("time.start (default 0) at " + m.str());
 }
 
 TimeSettings time_settings(const Node& root) {

@@ -171,6 +171,10 @@ class BeamModel {
   void restore();
   // Direct manipulation (tests): rigid motion of the current state.
   void set_state(const std::vector<Vec3>& x, const std::vector<Quat>& R);
+  // Continue from a committed state (state_file.hpp): positions, rotations and the plastic state of
+  // every element become the committed and current ones at time t.
+  void start_from(double t, const std::vector<Vec3>& x, const std::vector<Quat>& R,
+                  const std::vector<PlasticState>& plastic);
 
   // Internal residual/tangent in the reduced (free) DOFs at the current state.
   void assemble(SpMat* K, Eigen::VectorXd& r);

@@ -45,6 +45,9 @@ class BeamSolverParticipant : public participant::BeamParticipant {
   bool last_written_ = true;
   StepRecord initial_{};  // stent measures of the reference state
   void stent_measures(StepRecord& r, bool reference) const;
+  // <run>/beam/state.h5 (output.state) with the last committed step, unless already written.
+  void write_state_();
+  int state_step_ = -1;  // committed step the state file holds
   participant::SolveStats solve_loads_(const std::vector<participant::Vec3>& line_loads);
 };
 

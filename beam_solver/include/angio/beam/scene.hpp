@@ -7,9 +7,11 @@
 #include <string>
 
 #include "angio/beam/model.hpp"
+#include "angio/beam/state_file.hpp"
 #include "angio/beam/stent_generator.hpp"
 #include "angio/scene/load_curve.hpp"
 #include "angio/scene/node.hpp"
+#include "angio/scene/output_settings.hpp"
 
 namespace angio::beam {
 
@@ -17,7 +19,10 @@ struct BeamScene {
   std::string file;
   std::unique_ptr<BeamModel> model;
   scene::TimeSettings time;
-  int output_every = 1;
+  scene::OutputSettings output;
+  // stent.initial_state: the committed stent of an earlier run (checked against this stent), applied
+  // by the participant; time.start is its time.
+  std::optional<BeamState> initial_state;
   bool generated_stent = false;
   std::optional<StentMesh> stent;
 };

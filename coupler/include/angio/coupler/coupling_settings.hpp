@@ -44,6 +44,11 @@ struct CouplingSettings {
   // accepted iterate's solid error is then at most that fraction of the residual before it.
   // 0: every solve to the solid's own tolerance.
   double inexact_solid = 0.0;
+  // The run continues from state files (stent.initial_state or solid.initial_state given): before the
+  // first step the interface state (the contact planes or loads of the committed state) is recomputed
+  // from the participants, as the accepted state of the step before (coupling_loop.hpp). Derived
+  // from the scene, not a key of `coupling:`.
+  bool synchronize = false;
 };
 
 CouplingSettings coupling_settings(const scene::Node& root);

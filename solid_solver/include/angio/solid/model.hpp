@@ -180,6 +180,24 @@ class SolidModel {
   const std::vector<double>& state() const { return u_; }
   void restore_state(const std::vector<double>& u) { u_ = u; }
 
+  // --- the committed state, as state files keep it (state_file.hpp)
+  double committed_time() const { return committed_time_; }
+  Vec3d committed_displacement(int node) const;  // original node index
+  // The commit before the last one (newton.extrapolate): its time, and its displacement (false: none)
+  bool before_state(double& time, std::vector<Vec3d>* u) const;
+  // Viscous history of local element i (local_elements() order): its Gauss points' committed Q and
+  // Sv (points = 0: no viscous branch). Writable only between steps, before a solve uses it.
+  struct ViscousState {
+    int points = 0;
+    Vec6* Q = nullptr;
+    Vec6* Sv = nullptr;
+  };
+  ViscousState viscous_state(size_t i);
+  // Continue from a committed state at time t: u by original node index becomes the committed and
+  // current displacement; u_before (empty: none) the commit before it, at before_time. Prescribed
+  // values are applied at t. The viscous history is set through viscous_state().
+  void start_from(double t, const std::vector<Vec3d>& u, const std::vector<Vec3d>& u_before, double before_time);
+
   // --- access (all ranks hold the full displacement)
   MPI_Comm comm() const { return comm_; }
   int rank() const { return rank_; }

@@ -106,6 +106,9 @@ class SolidRunner : public participant::SolidParticipant {
  private:
   void record_and_write_(int step, double time);
   void write_summary_json_() const;
+  // <run>/solid/state.h5 (output.state) with the last committed step, unless already written. Collective.
+  void write_state_();
+  int state_step_ = -1;  // committed step the state file holds
 
   MPI_Comm comm_;
   int rank_ = 0;

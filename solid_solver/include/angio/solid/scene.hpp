@@ -7,7 +7,9 @@
 
 #include "angio/scene/load_curve.hpp"
 #include "angio/scene/node.hpp"
+#include "angio/scene/output_settings.hpp"
 #include "angio/solid/model.hpp"
+#include "angio/solid/state_file.hpp"
 
 namespace angio::solid {
 
@@ -66,7 +68,11 @@ struct SolidScene {
   // Norm of the nodal force vector of all pressures at their curves' peaks, reference mesh (N): the
   // scale solid.newton.atol is checked against (load_scale.hpp).
   double peak_load_norm = 0.0;
-  int output_every = 1;
+  scene::OutputSettings output;
+  // solid.initial_state: the run continues from these parts of a state file (state_file.hpp), read
+  // and checked against the mesh while the scene is read; time.start is the state's time.
+  std::optional<StateFile> initial_state;
+  std::vector<std::string> initial_parts;
   scene::TimeSettings time;
 };
 

@@ -71,5 +71,8 @@ struct TimeSettings {
   std::vector<double> stops;
 };
 TimeSettings time_settings(const Node& root);
+// A run continued from a state file starts at the state's time: otherwise a SceneError on
+// time.start naming the state (`state` describes it, e.g. its path).
+void require_start_at(const Node& root, const TimeSettings& time, double state_time, const std::string& state);
 
 }  // namespace angio::scene

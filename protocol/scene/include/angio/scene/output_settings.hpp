@@ -1,0 +1,17 @@
+// The `output:` section, shared by the solvers: how often fields are written and whether each
+// solver keeps a state file to continue from (a later phase of a procedure, or a resumed run).
+#pragma once
+#include "angio/scene/node.hpp"
+
+namespace angio::scene {
+
+struct OutputSettings {
+  int every = 1;       // fields at every `every`-th committed step (and the first)
+  // A state file (<run>/<solver>/state.h5) rewritten at the steps with fields and at the end of the
+  // run: the committed state a later run starts from (solid.initial_state, stent.initial_state).
+  bool state = true;
+};
+// Reads `output:` (absent: the defaults); unknown keys are refused.
+OutputSettings output_settings(const Node& root);
+
+}  // namespace angio::scene

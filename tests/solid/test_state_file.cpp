@@ -1,0 +1,193 @@
+// Solid state files (state_file.hpp): a run continued from the state file of its first half ends
+// where the uninterrupted run ends (consistency: the same committed displacement, viscous history and
+// extrapolation base, so the same equilibria to round-off); a state lands on the parts named and only
+// on the mesh it came from, and every mismatch is a scene error naming the key.
+#include <gtest/gtest.h>
+#include <mpi.h>
+#include <petscsys.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "angio/participant/standalone.hpp"
+#include "angio/solid/participant.hpp"
+#include "angio/solid/scene.hpp"
+#include "mpi_test.hpp"
+
+using namespace angio::solid;
+using angio_test::world_rank;
+using angio_test::world_size;
+
+namespace {
+
+// A small two-layer artery with a viscous media (eqs. B.5–B.8): pressure ramped to t = 0.5 s, then
+// held (the media relaxes: the viscous history matters after the restart); exact Newton and the
+// extrapolated first iterate (the commit before the last matters too).
+const char* kArtery = R"(
+time: {start: 0.0, end: 1.0, steps: 8}
+load_curves:
+  p: [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]
+output: {every: 2}
+BALLOON
+artery:
+  mesh:
+    generator: tube
+    length: 2.0
+    outer_diameter: 2.8
+    n_circ: NCIRC
+    n_axial: 4
+    layers:
+      - {name: media, thickness: 0.3, n_radial: 1}
+      - {name: adventitia, thickness: 0.3, n_radial: 1}
+  layers:
+    media: {E: 0.1566, nu: 0.45, fibers: [{k1: 0.00064, k2: 3.54, angle: 0, pair: true}], viscous: {tau: 0.2, beta: 0.5}}
+    adventitia: {E: 0.01566, nu: 0.45, fibers: [{k1: 0.0051, k2: 15.4, angle: 40, pair: true}]}
+  blood_pressure: {value: 0.035, curve: p}
+  end_springs: 1000.0
+  fixed: [{surface: end0, components: [z]}]
+solid:
+  petsc_options: "-ksp_type preonly -pc_type lu"
+  newton: {rtol: 1.0e-12, atol: 1.0e-12, continuation: 0, prediction: extrapolate}
+  INITIAL
+)";
+
+const char* kBalloon = R"(balloon:
+  mesh: {generator: tube, length: 1.6, outer_diameter: 0.98, wall: 0.04, n_circ: 12, n_axial: 4, center: [0, 0, 0]}
+  material: {E: 17.0, nu: 0.3}
+  pressure: {value: 0.01, curve: p}
+  end_springs: 100.0)";
+
+std::string dir_of(const std::string& name) {
+  // per rank count: the np1 and np2 test runs may run concurrently
+  return (std::filesystem::current_path() / ("state_file_test_np" + std::to_string(world_size()) + "/" + name)).string();
+}
+
+// Writes the scene (rank 0) and returns its path; `time` replaces the time line, `initial` the
+// solid.initial_state entry.
+std::string scene_file(const std::string& name, const std::string& time, const std::string& initial,
+                       bool balloon = false, int n_circ = 12) {
+  std::string t = kArtery;
+  if (!time.empty()) t = std::regex_replace(t, std::regex("time: \\{[^}]*\\}"), time);
+  t = std::regex_replace(t, std::regex("INITIAL"), initial);
+  t = std::regex_replace(t, std::regex("BALLOON"), balloon ? kBalloon : "");
+  t = std::regex_replace(t, std::regex("NCIRC"), std::to_string(n_circ));
+  const std::string dir = dir_of("scenes");
+  const std::string path = dir + "/" + name + ".yaml";
+  if (world_rank() == 0) {
+    std::filesystem::create_directories(dir);
+    std::ofstream(path) << t;
+  }
+  MPI_Barrier(PETSC_COMM_WORLD);
+  return path;
+}
+
+SolidScene read(const std::string& path) { return read_solid_scene(angio::scene::load_scene(path)); }
+
+std::vector<Vec3d> run(const std::string& scene, const std::string& run_dir) {
+  SolidScene sc = read(scene);
+  const auto time = sc.time;
+  SolidRunner runner(PETSC_COMM_WORLD, std::move(sc), run_dir);
+  EXPECT_EQ(angio::participant::run_standalone(runner, time), 0);
+  std::vector<Vec3d> u;
+  for (size_t n = 0; n < runner.model().mesh().X.size(); ++n) u.push_back(runner.model().displacement(int(n)));
+  return u;
+}
+
+double max_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
+  double d = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) d = std::max(d, (a[i] - b[i]).norm());
+  return d;
+}
+
+// The first half's state, written once per test process.
+const std::string& first_half_state() {
+  static std::string state;
+  if (state.empty()) {
+    run(scene_file("first_half", "time: {start: 0.0, end: 0.5, steps: 4}", ""), dir_of("first_half"));
+    state = dir_of("first_half") + "/solid/state.h5";
+  }
+  return state;
+}
+
+std::string initial(const std::string& parts = "") {
+  return "initial_state: {file: " + first_half_state() + (parts.empty() ? "" : ", parts: " + parts) + "}";
+}
+
+}  // namespace
+
+TEST(StateFile, ContinuedRunEndsWhereTheUninterruptedRunEnds) {
+  const auto whole = run(scene_file("whole", "", ""), dir_of("whole"));
+  const std::string& state_path = first_half_state();
+  const StateFile state = read_state_file(state_path);
+  EXPECT_NEAR(state.time, 0.5, 1e-15);
+  ASSERT_EQ(state.parts.size(), 1u);
+  EXPECT_EQ(state.parts[0].name, "artery");
+  EXPECT_TRUE(state.has_before);  // prediction: extrapolate keeps the commit before
+  EXPECT_NEAR(state.before_time, 0.375, 1e-15);
+  double q = 0.0;
+  for (const auto& Q : state.parts[0].Q) q = std::max(q, Q.norm());
+  EXPECT_GT(q, 1e-4);  // the media's overstress at the end of the ramp (MPa): the history is not trivial
+
+  const auto continued = run(scene_file("second_half", "time: {start: 0.5, end: 1.0, steps: 4}", initial()),
+                             dir_of("second_half"));
+  double umax = 0.0;
+  for (const auto& u : whole) umax = std::max(umax, u.norm());
+  const double diff = max_difference(whole, continued);
+  if (world_rank() == 0)
+    std::printf("max |u| at t = 1: %.6f mm, continued - uninterrupted: %.3e mm\n", umax, diff);
+  EXPECT_GT(umax, 0.05);
+  EXPECT_LT(diff, 1e-10 * umax);
+
+  // the same continuation with the history dropped (a fresh viscous branch) ends elsewhere: the
+  // check above sees the history
+  SolidScene sc = read(scene_file("second_half_fresh", "time: {start: 0.5, end: 1.0, steps: 4}", initial()));
+  for (auto& p : sc.initial_state->parts)
+    for (auto& Q : p.Q) Q.setZero();
+  const auto time = sc.time;
+  SolidRunner fresh(PETSC_COMM_WORLD, std::move(sc), "");
+  ASSERT_EQ(angio::participant::run_standalone(fresh, time), 0);
+  std::vector<Vec3d> uf;
+  for (size_t n = 0; n < fresh.model().mesh().X.size(); ++n) uf.push_back(fresh.model().displacement(int(n)));
+  EXPECT_GT(max_difference(whole, uf), 1e3 * diff + 1e-8);
+}
+
+TEST(StateFile, PartsLandOnTheirNodesOthersStartUndeformed) {
+  // the artery of the state under a new balloon (the next phase of a procedure)
+  SolidScene sc = read(scene_file("with_balloon", "time: {start: 0.5, end: 1.0, steps: 1}", initial("[artery]"), true));
+  const StateFile state = *sc.initial_state;  // a copy: the runner drops its own once applied
+  SolidRunner runner(PETSC_COMM_WORLD, std::move(sc), "");
+  const Mesh& mesh = runner.model().mesh();
+  const auto nodes = part_nodes(mesh, "artery");
+  ASSERT_EQ(nodes.size(), state.parts[0].u.size());
+  double diff = 0.0, balloon = 0.0;
+  for (size_t i = 0; i < nodes.size(); ++i) diff = std::max(diff, (runner.model().displacement(nodes[i]) - state.parts[0].u[i]).norm());
+  for (int n : part_nodes(mesh, "balloon")) balloon = std::max(balloon, runner.model().displacement(n).norm());
+  EXPECT_EQ(diff, 0.0);
+  EXPECT_EQ(balloon, 0.0);
+  EXPECT_GT(state.parts[0].u[0].norm(), 0.0);
+}
+
+TEST(StateFile, MismatchesAreSceneErrorsNamingTheKey) {
+  auto message = [](const std::string& path) {
+    try {
+      read(path);
+    } catch (const angio::scene::SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string t = "time: {start: 0.5, end: 1.0, steps: 1}";
+  EXPECT_NE(message(scene_file("other_mesh", t, initial(), false, 16)).find("solid.initial_state.file: expected parts that fit this scene's mesh"),
+            std::string::npos);
+  EXPECT_NE(message(scene_file("other_mesh", t, initial(), false, 16)).find("a different mesh"), std::string::npos);
+  EXPECT_NE(message(scene_file("no_part", t, initial("[balloon]"), true)).find("has no part 'balloon'"), std::string::npos);
+  EXPECT_NE(message(scene_file("twice", t, initial("[artery, artery]"))).find("each part once"), std::string::npos);
+  EXPECT_NE(message(scene_file("time", "time: {start: 0.25, end: 1.0, steps: 1}", initial())).find("time.start"),
+            std::string::npos);
+  EXPECT_NE(message(scene_file("missing", t, "initial_state: {file: no_such_state.h5}")).find("no such file"),
+            std::string::npos);
+  EXPECT_NE(message(scene_file("not_hdf5", t, "initial_state: {file: not_hdf5.yaml}")).find("not an HDF5 file"),
+            std::string::npos);
+}
