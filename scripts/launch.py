@@ -42,7 +42,8 @@ UNIX_PATH_MAX = 107
 # The top-level sections some executable reads (docs/user-guide.md "Scenes"). The launcher picks the processes
 # from these keys, so a misspelt one must stop the launch instead of silently running another
 # simulation (a scene without its `stent` runs the balloon alone).
-SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling", "patient")
+SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling", "patient",
+            "procedure")
 # Catches typos (-n 2000 oversubscribes the machine into the ground) without limiting real runs.
 MAX_RANKS = 256
 # The run id is a chunk of the zenoh key expressions angio/<run_id>/...: '/' would shift the chunks
@@ -427,6 +428,35 @@ def stop_all(procs, grace=5.0):
             pr.p.wait()
 
 
+def run_procedure(scene, scene_path, scene_text, args):
+    """A scene with `procedure:`: every phase checked, then run one after the other into
+    <run dir>/<k>-<name>/ (scripts/procedure.py)."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import procedure
+    for opt in ("record", "run_id", "beam_cmd", "solid_cmd"):
+        if getattr(args, opt):
+            die(f"--{opt.replace('_', '-')}: not supported for a procedure (a scene with `procedure:`)")
+    passed = ["--build-dir", args.build_dir, "--transport", args.transport, "--log-level", args.log_level]
+    passed += (["--ranks", str(args.ranks)] if args.ranks is not None else []) + (["--verbose"] if args.verbose else [])
+    passed += ["--timeout", str(args.timeout)] if args.timeout is not None else []
+    try:
+        if args.check:
+            procedure.check(scene, scene_path, passed)
+            print(f"launch: {scene_path}: the procedure is valid (every phase checked)")
+            return 0
+        procedure.phases(scene, scene_path)
+        procedure.check(scene, scene_path, passed)
+    except procedure.ProcedureError as e:
+        die(str(e))
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    run_dir = Path(args.run_dir or ROOT / "runs" / f"{scene_path.stem}-{stamp}-{uuid.uuid4().hex[:12]}").resolve()
+    make_run_dir(run_dir, explicit=args.run_dir is not None)
+    lock = lock_run_dir(run_dir)  # noqa: F841 (held until return)
+    (run_dir / "scene.yaml").write_bytes(scene_text)
+    print(f"launch: procedure run directory {run_dir}")
+    return procedure.run(scene, scene_path, run_dir, passed)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="scene file (YAML)")
@@ -460,6 +490,8 @@ def main():
     # All of the input is checked before the run directory exists: bad input leaves nothing behind.
     scene_path = Path(args.scene).resolve()
     scene, scene_text = load_scene(scene_path)
+    if "procedure" in scene:  # phases, each a launch of its own (scripts/procedure.py)
+        return run_procedure(scene, scene_path, scene_text, args)
     has_stent = "stent" in scene
     has_solid = "balloon" in scene or "artery" in scene
     if not has_stent and not has_solid:

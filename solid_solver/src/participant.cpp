@@ -423,7 +423,10 @@ void SolidRunner::record_and_write_(int step, double time) {
     s.solve_seconds = last_.total_seconds;
   }
   history_.push_back(s);
-  if (writer_ && (step % scene_.output.every == 0 || step == 0)) {
+  // the first and the last step always (a run continued from it, e.g. the next phase of a procedure,
+  // starts where the fields end)
+  const bool last = time >= scene_.time.end - 1e-12 * std::max(1.0, std::abs(scene_.time.end));
+  if (writer_ && (step % scene_.output.every == 0 || step == 0 || last)) {
     std::vector<std::pair<std::string, const std::vector<double>*>> nodal;
     if (!contact_pressure.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);
     std::vector<std::vector<double>> fields(recovery_->num_blocks());

@@ -1,0 +1,318 @@
+"""A procedure of phases in one scene: predilatation, stenting, post-dilatation (or any sequence).
+
+A scene with a `procedure:` list runs one phase after the other on one time axis, each phase a
+run of the launcher in <run>/<k>-<name>/. The artery carries over from phase to phase (its
+displacement and viscous history: `solid.initial_state` with parts [artery] from the previous
+phase's solid/state.h5), the stent from the phase that deploys it on (its positions, rotations and
+plastic strains: `stent.initial_state`); each phase brings its own balloon (`balloon:` of the phase,
+else the scene's), which starts crimped and is gone in the next phase.
+
+    procedure:
+      - {name: predilatation, end: 2.0, steps: 40, balloon: {...}}          # no stent yet
+      - {name: stenting, end: 4.0, steps: 60, stent: true}                   # the scene's stent and balloon
+      - {name: postdilatation, end: 6.0, steps: 40, balloon: {...}}         # the stent stays
+
+The first phase starts at time.start; each later one where the one before ended. Load curves are in
+that one time axis. `time:` keeps its other keys (min_step, max_cuts, adaptive); its `end` and
+`steps` are per phase. Devices are placed where the scene places them (on the vessel axis), not on
+the deformed lumen's centerline: right for straight and gently curved vessels, whose axis a
+dilatation does not move.
+
+After the last phase (or a failed one) <run>/procedure.json holds per phase: status, wall time,
+steps, and the quantities interventional studies report (minimal lumen diameter and area at the
+phase's peak balloon pressure and at its end, lumen gain against the lumen before the procedure,
+acute recoil, stent diameter, malapposed fraction, per-layer stress maxima at peak and end), and
+lumen_profiles.png the lumen diameter along the vessel before the procedure and after each phase.
+"""
+import copy
+import json
+import math
+import re
+import subprocess
+import sys
+import tempfile
+import time as clock
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parent.parent
+LAUNCH = ROOT / "scripts" / "launch.py"
+PHASE_KEYS = ("name", "end", "steps", "balloon", "stent")
+NAME = re.compile(r"[A-Za-z0-9_-]{1,40}")
+STENT_CONTACTS = ("stent_balloon", "stent_artery")
+
+
+class ProcedureError(Exception):
+    """Bad input of the procedure: the message names the file and the key."""
+
+
+def _number(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def phases(scene, path):
+    """The phases of `procedure:` with their time windows: [{name, start, end, steps, balloon, stent}].
+    Raises ProcedureError naming the key."""
+    proc = scene.get("procedure")
+    if not isinstance(proc, list) or not proc:
+        raise ProcedureError(f"{path}: procedure: expected a non-empty list of phases, got {proc!r:.60}")
+    if "artery" not in scene:
+        raise ProcedureError(f"{path}: procedure: expected an `artery:` section (the procedure carries the artery "
+                             "from phase to phase), got none")
+    if "patient" in scene:
+        raise ProcedureError(f"{path}: procedure: expected a scene with its artery given directly, got a `patient:` "
+                             "section (a patient procedure is not supported yet)")
+    t = scene.get("time") or {}
+    if not isinstance(t, dict):
+        raise ProcedureError(f"{path}: time: expected a map, got {t!r:.60}")
+    for k in ("end", "steps"):
+        if k in t:
+            raise ProcedureError(f"{path}: time.{k}: expected it per phase (procedure[k].{k}) in a procedure, "
+                                 "got it in `time:`")
+    start = t.get("start", 0.0)
+    if not _number(start):
+        raise ProcedureError(f"{path}: time.start: expected a number, got {start!r:.60}")
+    out, names, stent_on = [], set(), False
+    for k, ph in enumerate(proc):
+        key = f"procedure[{k}]"
+        if not isinstance(ph, dict):
+            raise ProcedureError(f"{path}: {key}: expected a map {{name, end, steps, balloon, stent}}, got {ph!r:.60}")
+        for x in ph:
+            if x not in PHASE_KEYS:
+                raise ProcedureError(f"{path}: {key}.{x}: expected one of {', '.join(PHASE_KEYS)}, got an unknown key")
+        name = ph.get("name")
+        if not isinstance(name, str) or not NAME.fullmatch(name):
+            raise ProcedureError(f"{path}: {key}.name: expected 1 to 40 of A-Z a-z 0-9 _ -, got {name!r:.60}")
+        if name in names:
+            raise ProcedureError(f"{path}: {key}.name: expected a name not used by an earlier phase, got {name!r}")
+        names.add(name)
+        end = ph.get("end")
+        if not _number(end) or not end > start:
+            raise ProcedureError(f"{path}: {key}.end: expected a time after the phase's start {start} s (phases "
+                                 f"follow each other without overlap or gap), got {end!r:.60}")
+        steps = ph.get("steps")
+        if not isinstance(steps, int) or isinstance(steps, bool) or not 1 <= steps <= 100000:
+            raise ProcedureError(f"{path}: {key}.steps: expected a number of load steps from 1 to 100000, "
+                                 f"got {steps!r:.60}")
+        stent = ph.get("stent", stent_on)
+        if not isinstance(stent, bool):
+            raise ProcedureError(f"{path}: {key}.stent: expected true or false, got {stent!r:.60}")
+        if stent_on and not stent:
+            raise ProcedureError(f"{path}: {key}.stent: expected true (the stent stays once deployed), got false")
+        if stent and "stent" not in scene:
+            raise ProcedureError(f"{path}: {key}.stent: expected a `stent:` section in the scene to deploy, got none")
+        balloon = ph.get("balloon", scene.get("balloon"))
+        if balloon is not None and not isinstance(balloon, dict):
+            raise ProcedureError(f"{path}: {key}.balloon: expected a balloon section (a map), got {balloon!r:.60}")
+        out.append({"name": name, "start": float(start), "end": float(end), "steps": steps, "balloon": balloon,
+                    "stent": stent})
+        start, stent_on = end, stent
+    return out
+
+
+def phase_scene(scene, phase, previous=None):
+    """The scene of one phase (a dict): the phase's time window, devices and contacts; `previous` =
+    (run dir of the phase before, whether it had the stent): the states it continues from."""
+    s = copy.deepcopy({k: v for k, v in scene.items() if k != "procedure"})
+    s["time"] = {**(scene.get("time") or {}), "start": phase["start"], "end": phase["end"], "steps": phase["steps"]}
+    if phase["balloon"] is not None:
+        s["balloon"] = copy.deepcopy(phase["balloon"])
+    else:
+        s.pop("balloon", None)
+    if not phase["stent"]:
+        s.pop("stent", None)
+        if isinstance(s.get("contact"), dict):
+            for c in STENT_CONTACTS:
+                s["contact"].pop(c, None)
+    if previous is not None:
+        prev_dir, prev_stent = previous
+        s.setdefault("solid", {})["initial_state"] = {"file": str(Path(prev_dir) / "solid" / "state.h5"),
+                                                      "parts": ["artery"]}
+        if prev_stent:
+            s["stent"]["initial_state"] = {"file": str(Path(prev_dir) / "beam" / "state.h5")}
+    return s
+
+
+def phase_dir(run_dir, k, phase):
+    return Path(run_dir) / f"{k + 1}-{phase['name']}"
+
+
+def _write(path, scene, note):
+    path.write_text(f"# {note}\n" + yaml.safe_dump(scene, sort_keys=False))
+
+
+def check(scene, path, launch_args):
+    """Every phase's scene through `launch.py --check` (without the states, which do not exist yet)."""
+    with tempfile.TemporaryDirectory(prefix="angio-procedure-") as tmp:
+        for k, ph in enumerate(phases(scene, path)):
+            p = Path(tmp) / f"{k + 1}-{ph['name']}.yaml"
+            _write(p, phase_scene(scene, ph), f"phase {k + 1} of {path}, as checked")
+            r = subprocess.run([sys.executable, str(LAUNCH), str(p), "--check"] + launch_args,
+                               capture_output=True, text=True)
+            if r.returncode != 0:
+                msg = (r.stderr.strip() or r.stdout.strip()).splitlines()
+                raise ProcedureError(f"{path}: procedure[{k}] ({ph['name']}): {msg[-1] if msg else 'check failed'}")
+
+
+# --- results per phase -------------------------------------------------------------------------
+
+def _load(p):
+    try:
+        return json.loads(Path(p).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _area(d):
+    return math.pi * d * d / 4.0 if _number(d) else None
+
+
+def _lumen_min(step, mask=None):
+    d = step.get("lumen_diameter") or []
+    vals = [x for i, x in enumerate(d) if _number(x) and (mask is None or mask[i])]
+    return min(vals) if vals else None
+
+
+def balloon_extent(balloon, artery):
+    """Axial extent of a generated (tube) balloon in the lumen stations' coordinate (along the artery's
+    tube axis, from its centre), or None for other meshes."""
+    try:
+        bm, am = balloon["mesh"], artery["mesh"]
+        if bm.get("generator") != "tube" or am.get("generator") != "tube" or "centerline" in bm or "centerline" in am:
+            return None
+        z = float((bm.get("center") or [0, 0, 0])[2]) - float((am.get("center") or [0, 0, 0])[2])
+        half = float(bm["length"]) / 2.0
+        return (z - half, z + half)
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None
+
+
+def treated_segment(scene, phases_, stations, stent_extent):
+    """The stations every device of the procedure covers (the union of the balloons' and the stent's
+    extents; QCA's "in-segment"), one segment for all phases so that their figures compare; None
+    (all stations) where an extent is unknown."""
+    ext = [balloon_extent(p["balloon"], scene["artery"]) for p in phases_ if p["balloon"] is not None]
+    if stent_extent:
+        ext.append(tuple(stent_extent))
+    if not stations or not ext or any(e is None for e in ext):
+        return None
+    lo, hi = min(e[0] for e in ext), max(e[1] for e in ext)
+    mask = [lo <= z <= hi for z in stations]
+    return mask if any(mask) else None
+
+
+def phase_results(pdir, phase, before, mask):
+    """Per-phase figures from the phase's solid (and beam) summaries; `before`: the solid summary step
+    of the lumen before the procedure; mask: the treated stations (None: all)."""
+    solid = _load(pdir / "solid" / "summary.json") or {}
+    steps = [s for s in solid.get("steps", []) if _number(s.get("time"))]
+    out = {"name": phase["name"], "start": phase["start"], "end": phase["end"], "stent": phase["stent"]}
+    if not steps:
+        return out
+    last = steps[-1]
+    peak = max(steps, key=lambda s: s.get("balloon_pressure") or 0.0)
+    d0 = _lumen_min(before, mask)
+    d_peak, d_end = _lumen_min(peak, mask), _lumen_min(last, mask)
+    out["lumen"] = {
+        "min_diameter_before_procedure": d0,
+        "min_diameter_at_peak": d_peak, "min_diameter_end": d_end,
+        "min_area_end": _area(d_end),
+        "gain_since_procedure_start": d_end - d0 if _number(d_end) and _number(d0) else None,
+        "acute_recoil": (d_peak - d_end) / d_peak if _number(d_peak) and _number(d_end) and d_peak > 0 else None,
+        "peak_time": peak.get("time"), "peak_balloon_pressure": peak.get("balloon_pressure"),
+    }
+    out["stress"] = {"at_peak": peak.get("max_principal_stress"), "end": last.get("max_principal_stress"),
+                     "p99_at_peak": peak.get("p99_principal_stress"), "p99_end": last.get("p99_principal_stress")}
+    if last.get("apposition"):
+        out["apposition_end"] = last["apposition"]
+    out["artery_contact_force_end"] = last.get("artery_contact_force")
+    beam = _load(pdir / "beam" / "summary.json")
+    if beam and isinstance(beam.get("diameter"), dict):
+        d = beam["diameter"]
+        out["stent_diameter"] = {"max": d.get("max"), "final": d.get("final")}
+    out["lumen_profile_end"] = last.get("lumen_diameter")
+    return out
+
+
+def summarize(run_dir, scene, path, ran):
+    """procedure.json and lumen_profiles.png from the phases that ran: [(k, phase, status, wall)]."""
+    run_dir = Path(run_dir)
+    first = _load(phase_dir(run_dir, 0, ran[0][1]) / "solid" / "summary.json") if ran else None
+    stations = (first or {}).get("lumen_stations") or []
+    if isinstance(stations, int):
+        stations = []
+    steps0 = [s for s in (first or {}).get("steps", []) if _number(s.get("time"))]
+    # before the procedure: the last step before the first balloon pressure (the prestressed lumen)
+    before = steps0[0] if steps0 else {}
+    for s in steps0:
+        if (s.get("balloon_pressure") or 0.0) > 0.0:
+            break
+        before = s
+    out = {"scene": str(path), "units": {"length": "mm", "area": "mm^2", "stress": "MPa", "time": "s"},
+           "lumen_before_procedure": {"time": before.get("time"), "profile": before.get("lumen_diameter"),
+                                      "stations": stations},
+           "phases": []}
+    stent_ext = None
+    for k, ph, _, _ in ran:
+        if ph["stent"]:
+            last = ((_load(phase_dir(run_dir, k, ph) / "solid" / "summary.json") or {}).get("steps") or [{}])[-1]
+            stent_ext = last.get("stent_stations") or stent_ext
+    mask = treated_segment(scene, [ph for _, ph, _, _ in ran], stations, stent_ext)
+    out["segment"] = ("stations covered by the procedure's devices (balloons and stent)" if mask
+                      else "all stations (a device extent is not known)")
+    for k, ph, status, wall in ran:
+        r = phase_results(phase_dir(run_dir, k, ph), ph, before, mask)
+        r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
+        out["phases"].append(r)
+    (run_dir / "procedure.json").write_text(json.dumps(out, indent=1) + "\n")
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        if stations and before.get("lumen_diameter"):
+            fig, ax = plt.subplots(figsize=(7, 4))
+            ax.plot(stations, before["lumen_diameter"], "k--", label="before the procedure")
+            for r in out["phases"]:
+                if r.get("lumen_profile_end"):
+                    ax.plot(stations, r["lumen_profile_end"], label=f"after {r['name']}")
+            ax.set_xlabel("station along the vessel (mm)")
+            ax.set_ylabel("lumen diameter (mm)")
+            ax.legend()
+            fig.tight_layout()
+            fig.savefig(run_dir / "lumen_profiles.png", dpi=120)
+            plt.close(fig)
+    except ImportError:
+        pass
+    return out
+
+
+def run(scene, path, run_dir, launch_args):
+    """Runs the phases one after the other (launch.py per phase); returns the exit code of the first
+    failing phase, else 0."""
+    ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
+    run_dir = Path(run_dir)
+    ran, previous, code = [], None, 0
+    for k, phase in enumerate(ph):
+        pdir = phase_dir(run_dir, k, phase)
+        scene_file = run_dir / f"{k + 1}-{phase['name']}.yaml"
+        _write(scene_file, phase_scene(scene, phase, previous), f"phase {k + 1} ({phase['name']}) of {path}")
+        print(f"procedure: phase {k + 1}/{len(ph)} {phase['name']}: t = {phase['start']} .. {phase['end']} s, "
+              f"{phase['steps']} steps{', stent' if phase['stent'] else ''}", flush=True)
+        t0 = clock.time()
+        rc = subprocess.call([sys.executable, str(LAUNCH), str(scene_file), "--run-dir", str(pdir)] + launch_args)
+        ran.append((k, phase, "ok" if rc == 0 else f"failed (exit {rc})", clock.time() - t0))
+        if rc != 0:
+            print(f"procedure: phase {phase['name']} failed (exit {rc}); later phases not run", file=sys.stderr)
+            code = rc
+            break
+        previous = (pdir, phase["stent"])
+    out = summarize(run_dir, scene, path, ran)
+    for r in out["phases"]:
+        lum = r.get("lumen") or {}
+        fmt = lambda v: f"{v:.3f}" if _number(v) else "-"  # noqa: E731
+        print(f"procedure: {r['name']:16s} {r['status']:10s} min lumen {fmt(lum.get('min_diameter_at_peak'))} mm at "
+              f"peak, {fmt(lum.get('min_diameter_end'))} mm at end (gain {fmt(lum.get('gain_since_procedure_start'))} "
+              f"mm, recoil {fmt(lum.get('acute_recoil'))}), {r['wall_seconds']} s")
+    print(f"procedure: {run_dir / 'procedure.json'}")
+    return code
