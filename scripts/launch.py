@@ -18,6 +18,7 @@ import atexit
 import ctypes
 import difflib
 import fcntl
+import json
 import math
 import os
 import re
@@ -428,6 +429,60 @@ def stop_all(procs, grace=5.0):
             pr.p.wait()
 
 
+def state_time(path):
+    """The committed pseudo-time of a solver's state file (state_file.hpp), or exit 2 naming it."""
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            t = float(f.attrs["time"])
+    except (OSError, KeyError, ValueError, ImportError) as e:
+        die(f"{path}: expected a state file of a run (output.state), got: {' '.join(str(e).split())}")
+    if not math.isfinite(t):
+        die(f"{path}: expected a finite time in the state file, got {t}")
+    return t
+
+
+def resumed_scene(scene, scene_path, run_dir):
+    """The scene continued from the state files of an earlier run of it (--resume): time.start at the
+    states' time, the steps left at the scene's nominal increment, every part from its state. Written
+    next to the scene as .<stem>.resume-<t>.yaml; returns its path."""
+    if "procedure" in scene or "patient" in scene:
+        die(f"--resume: a {'procedure' if 'procedure' in scene else 'patient scene'} cannot be resumed yet; "
+            "continue it with solid.initial_state / stent.initial_state by hand")
+    states = {}
+    if "stent" in scene:
+        states["beam"] = run_dir / "beam" / "state.h5"
+    if "balloon" in scene or "artery" in scene:
+        states["solid"] = run_dir / "solid" / "state.h5"
+    for p in states.values():
+        if not p.is_file():
+            die(f"--resume {run_dir}: expected {p} (a run of this scene with output.state), got none")
+    times = {k: state_time(p) for k, p in states.items()}
+    t = next(iter(times.values()))
+    if any(abs(v - t) > 1e-9 * max(1.0, abs(t)) for v in times.values()):
+        die(f"--resume {run_dir}: expected the solvers' state files at one time, got "
+            + ", ".join(f"{k} t = {v}" for k, v in times.items()) + " (the run stopped while they were written)")
+    ts = dict(scene.get("time") or {})
+    start, end, steps = float(ts.get("start", 0.0)), float(ts.get("end", 1.0)), int(ts.get("steps", 1))
+    if not t < end - 1e-12 * max(1.0, abs(end)):
+        die(f"--resume {run_dir}: the states are at t = {t} s, the scene's end (time.end = {end} s): nothing left to run")
+    ts.update(start=t, steps=max(1, round(steps * (end - t) / (end - start))))
+    s = json.loads(json.dumps(scene))
+    s["time"] = ts
+    if "beam" in states:
+        s["stent"]["initial_state"] = {"file": str(states["beam"])}
+    if "solid" in states:
+        s.setdefault("solid", {})["initial_state"] = {"file": str(states["solid"])}
+    path = scene_path.parent / f".{scene_path.stem}.resume-{t:g}.yaml"
+    try:
+        path.write_text(f"# {scene_path.name} continued from {run_dir} at t = {t} s (launch.py --resume)\n"
+                        + yaml.safe_dump(s, sort_keys=False))
+    except OSError as e:
+        die(f"{path}: cannot write the continued scene: {e.strerror}")
+    print(f"launch: resuming {scene_path.name} from {run_dir} at t = {t} s ({ts['steps']} steps left)")
+    return path
+
+
 def run_procedure(scene, scene_path, scene_text, args):
     """A scene with `procedure:`: every phase checked, then run one after the other into
     <run dir>/<k>-<name>/ (scripts/procedure.py)."""
@@ -474,6 +529,9 @@ def main():
     ap.add_argument("--run-id", help="run id (default: random); replays need the recorded one")
     ap.add_argument("--beam-cmd", help="replace the beam participant executable (same CLI)")
     ap.add_argument("--solid-cmd", help="replace the solid participant executable (same CLI)")
+    ap.add_argument("--resume", metavar="RUN_DIR",
+                    help="continue a stopped run of this scene from its state files (RUN_DIR/solid/state.h5, "
+                         "beam/state.h5) to the scene's end, into RUN_DIR/continued-<time>/ unless --run-dir")
     ap.add_argument("--check", action="store_true",
                     help="check the scene (every executable reads its keys; a patient's geometry is generated "
                          "and meshed) and exit 0, or 2 naming the file and key; nothing is run or written")
@@ -490,6 +548,12 @@ def main():
     # All of the input is checked before the run directory exists: bad input leaves nothing behind.
     scene_path = Path(args.scene).resolve()
     scene, scene_text = load_scene(scene_path)
+    if args.resume:
+        resume_dir = Path(args.resume).resolve()
+        scene_path = resumed_scene(scene, scene_path, resume_dir)
+        scene, scene_text = load_scene(scene_path)
+        if args.run_dir is None:
+            args.run_dir = str(resume_dir / f"continued-{time.strftime('%Y%m%d-%H%M%S')}")
     if "procedure" in scene:  # phases, each a launch of its own (scripts/procedure.py)
         return run_procedure(scene, scene_path, scene_text, args)
     has_stent = "stent" in scene

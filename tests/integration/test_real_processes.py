@@ -9,8 +9,8 @@
        the coupler sends equals the recorded one, relative tolerance 1e-9);
    (b) the real beam_solver driven by the recorded requests reproduces the recorded replies;
    (c) the same for the real solid_solver on 2 MPI ranks.
-3. A run continued from the state files of the first step (stent.initial_state, solid.initial_state)
-   ends where the uninterrupted run ends: the stent's final positions agree to 1 % of their motion
+3. A run continued from the state files of the first step (launch.py --resume: stent.initial_state,
+   solid.initial_state) ends where the uninterrupted run ends: the stent's final positions agree to 1 % of their motion
    over the second step (the coupler recomputes the contact planes of the committed state before it
    starts; without them the stent would spring back in its first iteration). A state of another mesh
    is refused by --check with exit 2 naming the key.
@@ -77,8 +77,12 @@ with tempfile.TemporaryDirectory() as tmp:
         r = run(LAUNCH + [str(first), "--run-dir", str(tmp / "first"), "--build-dir", str(BIN.parent), "--timeout", "120"])
         check(r.returncode == 0 and (tmp / "first" / "solid" / "state.h5").is_file()
               and (tmp / "first" / "beam" / "state.h5").is_file(), f"first step writes both state files (rc {r.returncode})")
-        second = variant("second", {"start": 0.5, "end": 1.0, "steps": 1}, tmp / "first")
-        r = run(LAUNCH + [str(second), "--run-dir", str(tmp / "second"), "--build-dir", str(BIN.parent), "--timeout", "120"])
+        # the scene itself resumed from the first step's states (launch.py --resume writes the continued
+        # scene: time.start at the states' time, the steps left, both initial_state keys)
+        scene_copy = tmp / "tiny_coupled.yaml"
+        scene_copy.write_text(SCENE.read_text())
+        r = run(LAUNCH + [str(scene_copy), "--resume", str(tmp / "first"), "--run-dir", str(tmp / "second"),
+                          "--build-dir", str(BIN.parent), "--timeout", "120"])
         check(r.returncode == 0, f"the continued run exits 0 (rc {r.returncode})\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
         if r.returncode == 0:
             log = (tmp / "second" / "coupler.log").read_text()
