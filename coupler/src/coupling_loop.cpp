@@ -52,6 +52,12 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     LOG_INFO("interface state recomputed at t = " << time.start << " s from the participants' committed states");
   }
   auto step_start = Clock::now();
+  // A step whose first coupling iteration fails in a participant from the extrapolated iterate (e.g.
+  // the extrapolated contact planes push struts into the wall and the beam's or the solid's Newton
+  // fails) is tried once more from the last accepted interface state before it is cut: the
+  // extrapolation, not the increment, was what failed. Its cuts, if it fails again, start from the
+  // last accepted state too (a hopeless step pays one extra attempt, not one per cut).
+  bool constant_retry = false;
   while (!stepper.finished()) {
     StepReport rep;
     rep.step = stepper.step();
@@ -61,7 +67,9 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     solid.begin_step(rep.step, rep.time);
     acc.begin_step();
 
-    scheme->begin_step(stepper.increment(), settings.prediction == "extrapolate");
+    const bool extrapolate = settings.prediction == "extrapolate" && !constant_retry;
+    scheme->begin_step(stepper.increment(), extrapolate);
+    int failed_at = -1;  // coupling iteration of a participant failure
 
     bool converged = false, participant_failed = false;
     std::string failure;
@@ -75,6 +83,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       rep.beam_time += seconds_since(t0);
       if (!bs.converged) {
         participant_failed = true;
+        failed_at = k;
         failure = newton_failure("beam", k, bs);
         break;
       }
@@ -84,6 +93,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       rep.solid_time += seconds_since(t0);
       if (!ss.converged) {
         participant_failed = true;
+        failed_at = k;
         failure = newton_failure("solid", k, ss);
         break;
       }
@@ -132,6 +142,16 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     run.solid_time += rep.solid_time;
     const bool accept =
         converged || (!participant_failed && !settings.strict && rep.iterations > 0);
+    if (!accept && failed_at == 0 && extrapolate) {
+      LOG_INFO("step " << rep.step << " t = " << rep.time << " s: " << failure
+                       << "; retrying the step from the last accepted interface state (no extrapolation)");
+      beam.end_step(false);
+      solid.end_step(false);
+      acc.end_step(false);
+      ++run.prediction_retries;
+      constant_retry = true;
+      continue;  // the same step again, not cut
+    }
     if (!accept) {
       if (!participant_failed)
         failure = "coupling did not converge in " + std::to_string(settings.max_iterations) +
@@ -150,6 +170,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
                        << " iterations (residual " << rep.residuals.back()
                        << "), accepted because coupling.strict is false");
     rep.converged = converged;
+    constant_retry = false;
     first_residual_force = step_first_force;
     beam.end_step(true);
     solid.end_step(true);

@@ -16,6 +16,7 @@ std::string coupling_summary_json(const std::string& status, const std::string& 
   j["error"] = error;
   j["steps"] = run.steps;
   j["rejected_attempts"] = run.rejected_attempts;
+  j["prediction_retries"] = run.prediction_retries;
   j["coupling_iterations_total"] = run.total_iterations;
   j["coupling_iterations_mean"] = finite(run.mean_iterations());
   j["coupling_iterations_max"] = run.max_iterations;

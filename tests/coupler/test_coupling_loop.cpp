@@ -79,6 +79,7 @@ TEST(CouplingLoop, ParticipantFailureCutsTheStep) {
   test::WallSolid wall;
   beam.fail_at_step = 2;
   coupler::CouplingSettings s;
+  s.prediction = "constant";  // nothing to fall back to: the failed step is cut
   coupler::Aitken aitken(0.5, 1.0);
   coupler::RunReport run;
   const auto reports = run_ramp(beam, wall, 4, s, aitken, &run);
@@ -87,6 +88,26 @@ TEST(CouplingLoop, ParticipantFailureCutsTheStep) {
   EXPECT_EQ(reports[1].cuts, 1);
   EXPECT_NEAR(reports[1].time, 0.375, 1e-12);  // half of the 0.25 increment after 0.25
   EXPECT_NEAR(reports.back().time, 1.0, 1e-12);
+}
+
+// With the extrapolated first iterate, a participant failure in the first coupling iteration is
+// retried once from the last accepted interface state before the step is cut: the step keeps its
+// increment, the participants were rolled back once.
+TEST(CouplingLoop, FailureFromTheExtrapolatedStartIsRetriedFromTheLastState) {
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  beam.fail_at_step = 2;
+  coupler::CouplingSettings s;
+  ASSERT_EQ(s.prediction, "extrapolate");
+  coupler::Aitken aitken(0.5, 1.0);
+  coupler::RunReport run;
+  const auto reports = run_ramp(beam, wall, 4, s, aitken, &run);
+  EXPECT_EQ(run.prediction_retries, 1);
+  EXPECT_EQ(run.rejected_attempts, 0);
+  EXPECT_EQ(beam.rejected, 1);
+  ASSERT_EQ(reports.size(), 4u);
+  EXPECT_EQ(reports[1].cuts, 0);
+  EXPECT_NEAR(reports[1].time, 0.5, 1e-12);  // not cut
 }
 
 TEST(CouplingLoop, NoContactConvergesInOneIteration) {

@@ -38,6 +38,7 @@ struct RunReport {
   double mean_iterations() const { return steps ? double(total_iterations) / steps : 0.0; }
   int max_iterations = 0;
   int rejected_attempts = 0;
+  int prediction_retries = 0;  // steps retried from the last accepted state after the extrapolated start failed
   double wall_time = 0.0;
   // s in solves over every attempt, rejected steps included
   double beam_time = 0.0;
