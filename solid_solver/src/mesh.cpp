@@ -172,6 +172,12 @@ void Mesh::orient_surfaces() {
   }
 }
 
+double TubeStenosis::lumen_radius(double Ri, double z) const {
+  const double d = z - position;
+  if (!(severity > 0.0) || std::abs(d) > 0.5 * length) return Ri;
+  return Ri * (1.0 - severity * 0.5 * (1.0 + std::cos(2.0 * std::numbers::pi * d / length)));
+}
+
 Mesh make_tube(const TubeSpec& s) {
   if (s.layers.empty()) throw std::runtime_error("tube: no layers");
   if (s.n_circ < 3 || s.n_axial < 1) throw std::runtime_error("tube: n_circ >= 3 and n_axial >= 1 required");
@@ -191,19 +197,27 @@ Mesh make_tube(const TubeSpec& s) {
     throw std::runtime_error("tube: " + std::to_string(s.length) + " mm starting at arc length " +
                              std::to_string(s.start) + " mm does not fit on the centerline (" +
                              std::to_string(s.centerline->length()) + " mm)");
+  if (s.stenosis.severity > 0.0 && !(s.stenosis.severity < 1.0 && s.stenosis.length > 0.0))
+    throw std::runtime_error("tube: a stenosis needs 0 < severity < 1 and a positive length");
   const int nc = s.n_circ, nr = int(radii.size()), na = s.n_axial + 1;
   auto node = [&](int i, int j, int k) { return (k * nr + j) * nc + (i % nc); };
   const double z0 = s.center.z() - 0.5 * s.length;
-  for (int k = 0; k < na; ++k)
+  const int n1 = s.layers.front().n_radial;  // shells 0..n1 bound the innermost layer
+  std::vector<double> r(nr);
+  for (int k = 0; k < na; ++k) {
+    const double zk = s.length * k / s.n_axial;  // from end0
+    const double rl = s.stenosis.lumen_radius(s.inner_radius, zk - 0.5 * s.length);
+    for (int j = 0; j < nr; ++j)
+      r[j] = j <= n1 ? rl + (radii[n1] - rl) * j / n1 : radii[j];
     for (int j = 0; j < nr; ++j)
       for (int i = 0; i < nc; ++i) {
         const double th = 2.0 * std::numbers::pi * i / nc;
         if (s.centerline)  // warp of the straight tube (paper §2.4), same map as the stent's
-          m.X.push_back(s.centerline->map(th, s.start + s.length * k / s.n_axial, radii[j]));
+          m.X.push_back(s.centerline->map(th, s.start + zk, r[j]));
         else
-          m.X.push_back(Vec3d(s.center.x() + radii[j] * std::cos(th), s.center.y() + radii[j] * std::sin(th),
-                              z0 + s.length * k / s.n_axial));
+          m.X.push_back(Vec3d(s.center.x() + r[j] * std::cos(th), s.center.y() + r[j] * std::sin(th), z0 + zk));
       }
+  }
   for (int k = 0; k + 1 < na; ++k)
     for (int j = 0; j + 1 < nr; ++j)
       for (int i = 0; i < nc; ++i) {

@@ -165,7 +165,8 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     return m;
   }
   mesh.check_keys(layered ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ",
-                                                               "n_axial", "center", "layers", "centerline", "start"}
+                                                               "n_axial", "center", "layers", "centerline", "start",
+                                                               "stenosis"}
                           : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall",
                                                                "n_circ", "n_axial", "center", "centerline", "start"});
   mesh.choice("generator", {"tube"});
@@ -197,6 +198,15 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   }
   t.inner_radius = ro - wall;
   if (!(t.inner_radius > 0)) mesh.child("outer_diameter").fail("an outer diameter larger than twice the wall thickness");
+  if (auto st = mesh.optional("stenosis")) {  // idealized concentric stenosis (mesh.hpp, TubeStenosis)
+    st->check_keys({"severity", "length", "position"});
+    t.stenosis.severity = st->in_range("severity", 0.0, 0.9);  // diameter stenosis; 90 % leaves a 10 % lumen
+    t.stenosis.length = st->positive("length");
+    t.stenosis.position = st->number_or("position", 0.0);
+    if (std::abs(t.stenosis.position) + 0.5 * t.stenosis.length > 0.5 * t.length)
+      st->child("length").fail("a stenosis within the tube (|position| + length/2 <= " + std::to_string(0.5 * t.length) +
+                               " mm)");
+  }
   if (auto cl = mesh.optional("centerline")) {
     // curved tube: the straight tube warped onto the centerline like the stent (paper §2.4)
     if (mesh.has("center")) mesh.child("center").fail("no 'center' with a 'centerline' (a curved tube is placed by centerline and start)");

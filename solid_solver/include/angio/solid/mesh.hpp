@@ -71,6 +71,20 @@ struct TubeLayer {
   double thickness = 0.0;
   int n_radial = 1;
 };
+// Idealized concentric stenosis of a tube (the straight stenosed vessel of the stenting literature,
+// e.g. Lally et al., J Biomech 38 (2005) 1574; Zahedmanesh & Lally, Med Biol Eng Comput 47 (2009)
+// 385): the lumen radius narrows as a cosine bump,
+//     r(z) = R_i (1 − s (1 + cos(2π (z − z_s)/L))/2)   for |z − z_s| ≤ L/2,   R_i elsewhere,
+// s the diameter stenosis (1 − D_min/D_ref), z_s its centre (axial, from the tube's centre), L its
+// length. The innermost layer takes up the narrowing (it is the plaque or intima): its shells are
+// spread evenly between r(z) and its outer radius, the other layers keep their thickness.
+struct TubeStenosis {
+  double severity = 0.0;  // 0 = none, < 1
+  double length = 0.0;    // mm
+  double position = 0.0;  // mm, centre along the axis from the tube's centre
+  // lumen radius at axial coordinate z (from the tube's centre) of a tube with inner radius Ri
+  double lumen_radius(double Ri, double z) const;
+};
 struct TubeSpec {
   std::string part;            // "balloon" / "artery"
   std::string surface_prefix;  // e.g. "balloon_"
@@ -82,6 +96,7 @@ struct TubeSpec {
   Vec3d center = Vec3d::Zero();
   std::optional<geometry::Centerline> centerline;  // curved axis (none: straight along +z)
   double start = 0.0;  // mm, arc length of end0 on the centerline
+  TubeStenosis stenosis;
 };
 // Throws std::runtime_error on bad parameters or a tube that does not fit on the centerline.
 Mesh make_tube(const TubeSpec& spec);
