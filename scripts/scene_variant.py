@@ -39,9 +39,9 @@ class SetError(ValueError):
 
 def apply_set(scene, changes, where):
     """Applies `changes` ({dotted.key.path: value}) to `scene` in place: each value replaces the
-    base's (a map or list included, as a whole); the maps on the way must exist in the base, so a
-    misspelt section is an error instead of a new key. `where` (e.g. "case.yaml: set") starts the
-    message of the SetError raised otherwise."""
+    base's (a map or list included, as a whole); the maps (or lists, indexed by a number, e.g.
+    procedure.2.steps) on the way must exist in the base, so a misspelt section is an error instead
+    of a new key. `where` (e.g. "case.yaml: set") starts the message of the SetError raised otherwise."""
     if not isinstance(changes, dict):
         raise SetError(f"{where}: expected a map of dotted key paths to values, got {type(changes).__name__}")
     for key, value in changes.items():
@@ -49,10 +49,21 @@ def apply_set(scene, changes, where):
             raise SetError(f"{where}: {key!r}: expected a dotted key path such as artery.mesh.n_circ")
         node, parts = scene, key.split(".")
         for p in parts[:-1]:
-            if not isinstance(node.get(p), dict):
+            if isinstance(node, list):
+                if not (p.isdigit() and int(p) < len(node) and isinstance(node[int(p)], (dict, list))):
+                    raise SetError(f"{where}: {key}: the base scene has no entry {p} in its list there")
+                node = node[int(p)]
+                continue
+            if not isinstance(node.get(p), (dict, list)):
                 raise SetError(f"{where}: {key}: the base scene has no map at '{p}'")
             node = node[p]
-        node[parts[-1]] = copy.deepcopy(value)
+        if isinstance(node, list):
+            last = parts[-1]
+            if not (last.isdigit() and int(last) < len(node)):
+                raise SetError(f"{where}: {key}: the base scene has no entry {last} in its list there")
+            node[int(last)] = copy.deepcopy(value)
+        else:
+            node[parts[-1]] = copy.deepcopy(value)
     return scene
 
 

@@ -70,10 +70,28 @@ def finite(v):
     return v is not None and (not isinstance(v, float) or math.isfinite(v))
 
 
+def run_dirs(run_dir):
+    """The run directories of a launch: the run itself, or a procedure's phases (procedure.json)."""
+    path = os.path.join(run_dir, "procedure.json")
+    if not os.path.exists(path):
+        return [run_dir]
+    return [p["run_dir"] for p in json.load(open(path)).get("phases", []) if p.get("run_dir")]
+
+
 def check_converge(run_dir, rc, log, problems):
     if rc != 0:
         problems.append(f"exit code {rc}, expected 0: {log[-300:]}")
         return
+    proc = os.path.join(run_dir, "procedure.json")
+    if os.path.exists(proc):
+        bad = [(p["name"], p["status"]) for p in json.load(open(proc))["phases"] if p.get("status") != "ok"]
+        if bad:
+            problems.append(f"procedure phases not ok: {bad}")
+    for d in run_dirs(run_dir):
+        check_converge_run(d, problems)
+
+
+def check_converge_run(run_dir, problems):
     coupled = os.path.exists(os.path.join(run_dir, "coupling_summary.json"))
     if coupled:
         c = json.load(open(os.path.join(run_dir, "coupling_summary.json")))
@@ -99,6 +117,11 @@ def check_stop(run_dir, rc, log, problems):
     # the coupler's (or a participant's) failure message: "step N ... t = T ... residual history [...]"
     if not re.search(r"\bstep \d+\b.*\bt = \S+.*residual history:? \[", log):
         problems.append("the error message does not name the step, the time and the residual history")
+    for d in run_dirs(run_dir):
+        check_stop_run(d, problems)
+
+
+def check_stop_run(run_dir, problems):
     committed = None
     path = os.path.join(run_dir, "coupling.csv")
     if os.path.exists(path):
@@ -141,10 +164,11 @@ def run_case(case_path, out_dir, build_dir):
     if rc is not None:
         (check_converge if case["expect"] == "converge" else check_stop)(run_dir, rc, log, problems)
     steps = cuts = None
-    path = os.path.join(run_dir, "coupling_summary.json")
-    if os.path.exists(path):
-        c = json.load(open(path))
-        steps, cuts = c.get("steps"), c.get("rejected_attempts")
+    for d in run_dirs(run_dir) if os.path.isdir(run_dir) else []:
+        path = os.path.join(d, "coupling_summary.json")
+        if os.path.exists(path):
+            c = json.load(open(path))
+            steps, cuts = (steps or 0) + (c.get("steps") or 0), (cuts or 0) + (c.get("rejected_attempts") or 0)
     return {"case": name, "expect": case["expect"], "rc": rc, "ok": not problems, "problems": problems,
             "steps": steps, "cuts": cuts, "wall_s": wall}
 
