@@ -202,6 +202,17 @@ def treated_segment(scene, phases_, stations, stent_extent):
     return mask if any(mask) else None
 
 
+def reference_area(before, mask):
+    """Mean lumen area before the procedure at the proximal and distal reference, the first station
+    outside the treated segment on either side (IVUS' reference lumen); None without a segment."""
+    d = before.get("lumen_diameter") or []
+    if mask is None or not any(mask) or len(d) != len(mask):
+        return None
+    inside = [i for i, m in enumerate(mask) if m]
+    refs = [d[i] for i in (inside[0] - 1, inside[-1] + 1) if 0 <= i < len(d) and _number(d[i])]
+    return sum(_area(x) for x in refs) / len(refs) if refs else None
+
+
 def phase_results(pdir, phase, before, mask):
     """Per-phase figures from the phase's solid (and beam) summaries; `before`: the solid summary step
     of the lumen before the procedure; mask: the treated stations (None: all)."""
@@ -223,7 +234,21 @@ def phase_results(pdir, phase, before, mask):
         "peak_time": peak.get("time"), "peak_balloon_pressure": peak.get("balloon_pressure"),
     }
     out["stress"] = {"at_peak": peak.get("max_principal_stress"), "end": last.get("max_principal_stress"),
-                     "p99_at_peak": peak.get("p99_principal_stress"), "p99_end": last.get("p99_principal_stress")}
+                     "p99_at_peak": peak.get("p99_principal_stress"), "p99_end": last.get("p99_principal_stress"),
+                     "endothelium_nodal_at_peak": peak.get("max_principal_stress_endothelium_nodal"),
+                     "endothelium_nodal_end": last.get("max_principal_stress_endothelium_nodal")}
+    # with the stent: the minimal lumen area inside it (stations within its extent) against the
+    # reference lumen area, IVUS' stent expansion (minimal stent area / reference lumen area; the
+    # lumen inside the stent is the stent's area where the struts are apposed)
+    ext = last.get("stent_stations")
+    stations = phase.get("_stations") or []
+    if phase["stent"] and ext and stations:
+        in_stent = [ext[0] <= z <= ext[1] for z in stations]
+        d_in = _lumen_min(last, in_stent) if any(in_stent) else None
+        ref = reference_area(before, mask)
+        out["in_stent"] = {"min_lumen_diameter_end": d_in, "min_lumen_area_end": _area(d_in),
+                           "reference_lumen_area": ref,
+                           "expansion": _area(d_in) / ref if _number(d_in) and ref else None}
     if last.get("apposition"):
         out["apposition_end"] = last["apposition"]
     out["artery_contact_force_end"] = last.get("artery_contact_force")
@@ -262,7 +287,7 @@ def summarize(run_dir, scene, path, ran):
     out["segment"] = ("stations covered by the procedure's devices (balloons and stent)" if mask
                       else "all stations (a device extent is not known)")
     for k, ph, status, wall in ran:
-        r = phase_results(phase_dir(run_dir, k, ph), ph, before, mask)
+        r = phase_results(phase_dir(run_dir, k, ph), {**ph, "_stations": stations}, before, mask)
         r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
         out["phases"].append(r)
     (run_dir / "procedure.json").write_text(json.dumps(out, indent=1) + "\n")

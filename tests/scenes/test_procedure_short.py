@@ -99,6 +99,11 @@ with tempfile.TemporaryDirectory() as tmp:
     d = (last.get("stent_diameter") or {}).get("final")
     check(isinstance(d, float) and d > 1.3, f"the stent stays open after the post-dilatation (D = {d} mm, crimped 1.15)")
     check((run / "lumen_profiles.png").is_file(), "lumen profiles plotted")
+    ins = [(p.get("in_stent") or {}) for p in proc["phases"][1:]]
+    check(len(ins) == 2 and all(isinstance(i.get("expansion"), float) and i["expansion"] > 0 for i in ins)
+          and ins[1]["min_lumen_diameter_end"] >= ins[0]["min_lumen_diameter_end"] - 0.01,
+          f"in-stent lumen and expansion after stenting and post-dilatation "
+          f"{[(i.get('min_lumen_diameter_end'), i.get('expansion')) for i in ins]} (the post-dilatation keeps it open)")
 
     # bad procedures: --check exits 2 naming the key, before anything runs
     base = yaml.safe_load(SCENE.read_text())
