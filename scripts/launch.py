@@ -509,7 +509,10 @@ def run_procedure(scene, scene_path, scene_text, args):
     lock = lock_run_dir(run_dir)  # noqa: F841 (held until return)
     (run_dir / "scene.yaml").write_bytes(scene_text)
     print(f"launch: procedure run directory {run_dir}")
-    return procedure.run(scene, scene_path, run_dir, passed)
+    try:
+        return procedure.run(scene, scene_path, run_dir, passed)
+    except procedure.ProcedureError as e:
+        die(str(e))
 
 
 def main():

@@ -60,9 +60,6 @@ def phases(scene, path):
     if "artery" not in scene:
         raise ProcedureError(f"{path}: procedure: expected an `artery:` section (the procedure carries the artery "
                              "from phase to phase), got none")
-    if "patient" in scene:
-        raise ProcedureError(f"{path}: procedure: expected a scene with its artery given directly, got a `patient:` "
-                             "section (a patient procedure is not supported yet)")
     t = scene.get("time") or {}
     if not isinstance(t, dict):
         raise ProcedureError(f"{path}: time: expected a map, got {t!r:.60}")
@@ -111,6 +108,49 @@ def phases(scene, path):
     return out
 
 
+def complete(scene, path, out_dir, log=print):
+    """A patient procedure (`patient:` with `procedure:`): the scene completed by the patient pipeline
+    into out_dir (the artery meshed from the lumen centerline, the stent and the scene's balloon placed
+    at the stenosis, the virtual insertion where the lesion is narrower than the devices), and each
+    phase's own balloon placed on the same device centerline, centred where the scene's balloon is.
+    Other scenes are returned unchanged. Raises ProcedureError naming the key."""
+    if "patient" not in scene:
+        return scene
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from patient.errors import PatientInputError
+    from patient.prepare import prepare_scene
+    try:
+        done, _ = prepare_scene({k: v for k, v in scene.items() if k != "procedure"}, path, out_dir,
+                                log=lambda m: log(f"procedure: {m}"))
+    except PatientInputError as e:
+        raise ProcedureError(str(e))
+    done["procedure"] = copy.deepcopy(scene["procedure"])
+    base = done["balloon"]["mesh"]
+    pts = [[float(v) for v in line.split()] for line in Path(base["centerline"]["file"]).read_text().splitlines()
+           if line.strip() and not line.lstrip().startswith("#")]
+    length = sum(math.dist(a, b) for a, b in zip(pts, pts[1:]))
+    centre = base["start"] + 0.5 * float(base["length"])
+    for k, ph in enumerate(done["procedure"]):
+        m = ph.get("balloon", {}).get("mesh") if isinstance(ph, dict) and isinstance(ph.get("balloon"), dict) else None
+        if not isinstance(m, dict):
+            continue
+        key = f"procedure[{k}].balloon.mesh"
+        for x in ("center", "centerline", "start", "file"):
+            if x in m:
+                raise ProcedureError(f"{path}: {key}.{x}: expected none with a `patient:` section (the phase's balloon "
+                                     "is placed on the device centerline at the stenosis)")
+        L = m.get("length")
+        if not _number(L) or L <= 0:
+            raise ProcedureError(f"{path}: {key}.length: expected a positive length (mm), got {L!r:.60}")
+        start = centre - 0.5 * L
+        if start < -1e-9 or start + L > length + 1e-9:
+            raise ProcedureError(f"{path}: {key}.length: expected a balloon that fits on the device centerline "
+                                 f"({length:.2f} mm) centred on the scene's balloon at {centre:.2f} mm, got {L} mm")
+        m["centerline"] = copy.deepcopy(base["centerline"])
+        m["start"] = round(max(start, 0.0), 9)
+    return done
+
+
 def phase_scene(scene, phase, previous=None):
     """The scene of one phase (a dict): the phase's time window, devices and contacts; `previous` =
     (run dir of the phase before, whether it had the stent): the states it continues from."""
@@ -143,8 +183,10 @@ def _write(path, scene, note):
 
 
 def check(scene, path, launch_args):
-    """Every phase's scene through `launch.py --check` (without the states, which do not exist yet)."""
+    """Every phase's scene through `launch.py --check` (without the states, which do not exist yet);
+    a patient procedure is completed (meshed and placed) into a scratch directory first."""
     with tempfile.TemporaryDirectory(prefix="angio-procedure-") as tmp:
+        scene = complete(scene, path, Path(tmp) / "geometry")
         for k, ph in enumerate(phases(scene, path)):
             p = Path(tmp) / f"{k + 1}-{ph['name']}.yaml"
             _write(p, phase_scene(scene, ph), f"phase {k + 1} of {path}, as checked")
@@ -315,8 +357,9 @@ def summarize(run_dir, scene, path, ran):
 def run(scene, path, run_dir, launch_args):
     """Runs the phases one after the other (launch.py per phase); returns the exit code of the first
     failing phase, else 0."""
-    ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
     run_dir = Path(run_dir)
+    scene = complete(scene, path, run_dir / "geometry")  # a patient procedure: meshed and placed again here
+    ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
     ran, previous, code = [], None, 0
     for k, phase in enumerate(ph):
         pdir = phase_dir(run_dir, k, phase)

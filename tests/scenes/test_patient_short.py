@@ -143,6 +143,34 @@ with tempfile.TemporaryDirectory(prefix="patient-short-") as tmp:
         check(force["stent"] > 0 and force["insertion"] == 0,
               f"at t = 0 the tool is gone and the wall rests on the stent ({force})")
 
+    # a procedure on the patient artery (checked, not run: each phase would cost a run of its own):
+    # the pipeline meshes and places once, each phase's balloon goes on the device centerline
+    def procedure(s, postdil_length=5.0):
+        s["time"] = {"start": -0.2, "min_step": 0.0005}
+        s["load_curves"].update(predil=[[0.0, 0.0], [0.5, 0.8], [1.0, 0.0]], deploy=[[1.0, 0.0], [1.5, 1.3], [2.0, 0.0]],
+                                postdil=[[2.0, 0.0], [2.5, 1.8], [3.0, 0.0]])
+        s["balloon"]["pressure"] = {"value": 1.0, "curve": "deploy"}
+        small = {**s["balloon"], "mesh": {**s["balloon"]["mesh"], "length": 5.0, "n_axial": 34},
+                 "pressure": {"value": 1.0, "curve": "predil"}}
+        post = {**small, "mesh": {**small["mesh"], "length": postdil_length}, "pressure": {"value": 1.0, "curve": "postdil"}}
+        s["procedure"] = [{"name": "predilatation", "end": 1.0, "steps": 20, "balloon": small},
+                          {"name": "stenting", "end": 2.0, "steps": 20, "stent": True},
+                          {"name": "postdilatation", "end": 3.0, "steps": 20, "balloon": post}]
+
+    def check_only(scene, name):
+        path = Path(tmp) / f"{name}.yaml"
+        path.write_text(yaml.safe_dump(scene, sort_keys=False))
+        return subprocess.run([sys.executable, str(ROOT / "scripts" / "launch.py"), str(path), "--check",
+                               "--build-dir", str(Path(BIN).parent)], capture_output=True, text=True, timeout=600)
+
+    p = check_only(scene_for("tiny.csv", p=procedure), "procedure")
+    check(p.returncode == 0 and "the procedure is valid" in p.stdout,
+          f"a patient procedure is meshed, placed and every phase checked (exit {p.returncode}) {p.stderr[-300:]}")
+    p = check_only(scene_for("tiny.csv", p=lambda s: procedure(s, postdil_length=12.0)), "procedure_long")
+    msg = p.stderr.strip().splitlines()[-1] if p.stderr.strip() else ""
+    check(p.returncode == 2 and "procedure[2].balloon.mesh.length" in msg,
+          f"a phase balloon longer than the device centerline: exit {p.returncode}, '{msg[:200]}'")
+
     # bad input: exit 2 naming the file and the problem (before anything is meshed)
     bad = [
         ("three points", lambda: write_centerline_csv(Path(tmp) / "b.csv", pts[:3], r[:3], wall[:3]), {},
