@@ -187,8 +187,13 @@ void BeamSolverParticipant::end_step(bool accept) {
 
 void BeamSolverParticipant::write_state_() {
   if (!out_ || !scene_.output.state || state_step_ == accepted_) return;
-  write_beam_state(*scene_.model, run_dir_ + "/beam/state.h5", accepted_);
   state_step_ = accepted_;
+  try {  // a state that cannot be written must not stop the run
+    write_beam_state(*scene_.model, run_dir_ + "/beam/state.h5", accepted_);
+  } catch (const std::exception& e) {
+    LOG_WARN("beam: state file not written at step " << accepted_ << ": " << e.what()
+                                                     << " (the previous one, if any, is kept)");
+  }
 }
 
 void BeamSolverParticipant::finish() {

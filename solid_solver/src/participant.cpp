@@ -560,8 +560,13 @@ void SolidRunner::write_summary_json_() const {
 
 void SolidRunner::write_state_() {
   if (!writer_ || !scene_.output.state || state_step_ == committed_) return;
-  write_state_file(*model_, dir_ + "/state.h5", committed_);
   state_step_ = committed_;
+  try {  // only rank 0 writes (after a collective gather): a failure there must not stop the run
+    write_state_file(*model_, dir_ + "/state.h5", committed_);
+  } catch (const std::exception& e) {
+    LOG_WARN("solid: state file not written at step " << committed_ << ": " << e.what()
+                                                       << " (the previous one, if any, is kept)");
+  }
 }
 
 void SolidRunner::finish() {
