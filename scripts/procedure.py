@@ -14,9 +14,10 @@ else the scene's), which starts crimped and is gone in the next phase.
 
 The first phase starts at time.start; each later one where the one before ended. Load curves are in
 that one time axis. `time:` keeps its other keys (min_step, max_cuts, adaptive); its `end` and
-`steps` are per phase. Devices are placed where the scene places them (on the vessel axis), not on
-the deformed lumen's centerline: right for straight and gently curved vessels, whose axis a
-dilatation does not move.
+`steps` are per phase. Devices are placed where the scene places them (on the vessel axis; in a
+patient scene the pipeline places the stent and the scene's balloon at the stenosis once and each
+phase's balloon on the same device centerline), not on the deformed lumen's centerline: right for
+straight and gently curved vessels, whose axis a dilatation hardly moves.
 
 After the last phase (or a failed one) <run>/procedure.json holds per phase: status, wall time,
 steps, and the quantities interventional studies report (minimal lumen diameter and area at the
