@@ -21,6 +21,7 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
   r.total_iterations = 14;
   r.max_iterations = 6;
   r.rejected_attempts = 2;
+  r.prediction_retries = 3;
   r.wall_time = 8.0;
   r.beam_time = 1.5;
   r.solid_time = 5.0;
@@ -37,10 +38,12 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
 
   EXPECT_EQ(j.at("status"), "failed");
   EXPECT_EQ(j.at("error").get<std::string>(), error);
-  for (const char* k : {"steps", "rejected_attempts", "coupling_iterations_total", "coupling_iterations_max"})
+  for (const char* k : {"steps", "rejected_attempts", "prediction_retries", "coupling_iterations_total",
+                        "coupling_iterations_max"})
     EXPECT_TRUE(j.at(k).is_number_integer()) << k;
   EXPECT_EQ(j.at("steps").get<int>(), 4);
   EXPECT_EQ(j.at("rejected_attempts").get<int>(), 2);
+  EXPECT_EQ(j.at("prediction_retries").get<int>(), 3);
   EXPECT_EQ(j.at("coupling_iterations_total").get<int>(), 14);
   EXPECT_DOUBLE_EQ(j.at("coupling_iterations_mean").get<double>(), 3.5);
   EXPECT_EQ(j.at("coupling_iterations_max").get<int>(), 6);
@@ -51,7 +54,7 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
   EXPECT_DOUBLE_EQ(j.at("messaging_share").get<double>(), 0.0625);
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
-  EXPECT_EQ(keys, (std::vector<std::string>{"status", "error", "steps", "rejected_attempts",
+  EXPECT_EQ(keys, (std::vector<std::string>{"status", "error", "steps", "rejected_attempts", "prediction_retries",
                                             "coupling_iterations_total", "coupling_iterations_mean",
                                             "coupling_iterations_max", "wall_time", "beam_time",
                                             "solid_time", "messaging_time", "messaging_share"}));
