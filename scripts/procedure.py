@@ -103,6 +103,12 @@ def phases(scene, path):
         balloon = ph.get("balloon", scene.get("balloon"))
         if balloon is not None and not isinstance(balloon, dict):
             raise ProcedureError(f"{path}: {key}.balloon: expected a balloon section (a map), got {balloon!r:.60}")
+        ext = balloon_extent(balloon, scene["artery"]) if balloon is not None else None
+        half = 0.5 * float(scene["artery"]["mesh"].get("length", 0.0)) if ext else 0.0
+        if ext and (ext[0] < -half - 1e-9 or ext[1] > half + 1e-9):
+            where = f"{key}.balloon.mesh" if "balloon" in ph else "balloon.mesh"
+            raise ProcedureError(f"{path}: {where}: expected a balloon within the artery (axially {-half:g} to {half:g} mm "
+                                 f"from its centre), got {ext[0]:g} to {ext[1]:g} mm")
         out.append({"name": name, "start": float(start), "end": float(end), "steps": steps, "balloon": balloon,
                     "stent": stent})
         start, stent_on = end, stent

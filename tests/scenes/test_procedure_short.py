@@ -123,4 +123,6 @@ with tempfile.TemporaryDirectory() as tmp:
     refused(lambda s: s["time"].update(end=3.0), "time.end", "time.end outside the phases")
     refused(lambda s: s["procedure"][2]["balloon"]["material"].update(E=-17.0), "balloon.material.E",
             "a bad value in a phase's balloon")
+    refused(lambda s: s["procedure"][0]["balloon"]["mesh"].update(length=6.0), "procedure[0].balloon.mesh",
+            "a balloon longer than the vessel")
 finish()
