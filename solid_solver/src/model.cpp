@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -382,6 +383,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     if (K) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
   };
   ViscousHistory vh;
+  int bad = -1;  // an element this rank found invalid
   for (size_t i = 0; i < local_elements_.size(); ++i) {
     const int e = local_elements_[i];
     const auto& el = mesh_.elements[e];
@@ -390,6 +392,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr, nullptr,
                           viscous_history_(i, vh))) {
       ok = 0;
+      bad = e;
       break;
     }
     add(el.nn());
@@ -412,6 +415,15 @@ bool SolidModel::assemble(Vec r, Mat K) {
   }
   int all_ok = 0;
   MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
+  if (!all_ok) {  // which element (the largest index of those found), for the failure messages
+    MPI_Allreduce(&bad, &invalid_element_, 1, MPI_INT, MPI_MAX, comm_);
+    if (invalid_element_ >= 0) {
+      const auto& el = mesh_.elements[invalid_element_];
+      invalid_at_ = Vec3d::Zero();
+      for (int a = 0; a < el.nn(); ++a) invalid_at_ += position(el.n[a]);
+      invalid_at_ /= double(el.nn());
+    }
+  }
   if (all_ok && contact_) {
     const double tc = MPI_Wtime();
     contact_->add(*this, r, K);
@@ -433,6 +445,15 @@ bool SolidModel::assemble(Vec r, Mat K) {
   if (K && apply_bc_)
     ANGIO_PETSC(MatZeroRows(K, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, nullptr, nullptr));
   return all_ok != 0;
+}
+
+std::string SolidModel::invalid_element() const {
+  if (invalid_element_ < 0) return "no element found invalid";
+  const auto& el = mesh_.elements[invalid_element_];
+  std::ostringstream m;
+  m << std::setprecision(4) << "last: element " << invalid_element_ << " of block '" << mesh_.blocks[el.block].name
+    << "' at (" << invalid_at_(0) << ", " << invalid_at_(1) << ", " << invalid_at_(2) << ") mm";
+  return m.str();
 }
 
 SolveReport SolidModel::solve(double loose_atol) {
@@ -517,7 +538,7 @@ SolveReport SolidModel::solve(double loose_atol) {
   // fresh: K_ holds the tangent at the current iterate (to be factorized); otherwise the modified
   // Newton iterates with the factorization held by the KSP.
   bool fresh = !modified || !pc_current_;
-  if (!assemble_here(fresh)) return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN)");
+  if (!assemble_here(fresh)) return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN; " + invalid_element() + ")");
   double res = norm(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
@@ -571,7 +592,7 @@ SolveReport SolidModel::solve(double loose_atol) {
       pc_current_ = reason > 0 || reason == KSP_DIVERGED_ITS;
       if (reuse && reason < 0) {  // the old factorization no longer serves: the current tangent instead
         rep.linear_seconds += MPI_Wtime() - t0;
-        if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it));
+        if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
         continue;
       }
     } else {
@@ -616,13 +637,14 @@ SolveReport SolidModel::solve(double loose_atol) {
     }
     if (stale && !(new_res < res)) {  // the old factorization diverges here: back, and the current tangent
       u_ = u_base;
-      if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it));
+      if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
       continue;
     }
     if (!accepted && !stale) {
       if (!std::isfinite(best_res))
         return fail("Newton iteration " + std::to_string(it) +
-                    ": every line-search trial gave an invalid configuration (inverted element or NaN)");
+                    ": every line-search trial gave an invalid configuration (inverted element or NaN; " +
+                    invalid_element() + ")");
       if (best_alpha != alpha) {  // r_ (and K_) hold the last trial: back to the best one
         alpha = best_alpha;
         for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
@@ -634,7 +656,7 @@ SolveReport SolidModel::solve(double loose_atol) {
       // keep the factorization while it contracts fast enough; otherwise the tangent here, for the
       // next iteration (the residual is assembled again with it)
       fresh = !(new_res <= no.max_contraction * res) && !converged(new_res, it + 1);
-      if (fresh && !assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it));
+      if (fresh && !assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
     }
     res = new_res;
     rep.residual_history.push_back(res);

@@ -658,3 +658,19 @@ TEST(Scene, AbsoluteToleranceOfTheOrderOfTheLoadIsRefused) {
   std::filesystem::remove(loose);
   std::filesystem::remove(fine);
 }
+
+// An invalid configuration is reported with the element that was found invalid: its index, block and
+// where it is (the centroid of that configuration).
+TEST(Model, InvalidConfigurationNamesTheElement) {
+  const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.0, 1);
+  LayerMaterial mat{"cube", {1.0, 0.3}, {}};
+  SolidModel model(PETSC_COMM_WORLD, m, {mat}, direct_options());
+  EXPECT_EQ(model.invalid_element(), "no element found invalid");
+  // turn the cube inside out through x = 0.5: every element is inverted
+  std::vector<Vec3d> u(m.X.size());
+  for (size_t n = 0; n < m.X.size(); ++n) u[n] = Vec3d(1.0 - 2.0 * m.X[n].x(), 0.0, 0.0);
+  model.set_displacement(u);
+  EXPECT_FALSE(model.assemble(model.residual_vector(), nullptr));
+  const std::string what = model.invalid_element();
+  EXPECT_NE(what.find("of block 'cube' at ("), std::string::npos) << what;
+}

@@ -227,6 +227,9 @@ class SolidModel {
   std::vector<Vec3d> contact_forces(ContactModel& c);
   // Assemble residual (and tangent) at the current state; for tests. Returns false on invalid state.
   bool assemble(Vec r, Mat K);
+  // The element an assemble() last found invalid (non-positive Jacobian or NaN), its block and the
+  // centroid of that configuration, for failure messages (same on every rank).
+  std::string invalid_element() const;
   Mat matrix() const { return K_; }
   Vec residual_vector() const { return r_; }
 
@@ -272,6 +275,8 @@ class SolidModel {
   void element_state_(int e, Eigen::MatrixXd& X, Eigen::MatrixXd& u) const;
   bool pc_current_ = false;  // the preconditioner holds a setup that may be reused (reuse_preconditioner, modified)
   double contact_seconds_ = 0.0;  // time in contact_->add() over the model's life (SolveReport::contact_seconds)
+  int invalid_element_ = -1;           // invalid_element()
+  Vec3d invalid_at_ = Vec3d::Zero();
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;
