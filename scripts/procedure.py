@@ -124,6 +124,8 @@ def complete(scene, path, out_dir, log=print):
     if "patient" not in scene:
         return scene
     sys.path.insert(0, str(ROOT / "scripts"))
+    import numpy as np
+    from patient.centerline_csv import arc_length
     from patient.errors import PatientInputError
     from patient.prepare import prepare_scene
     try:
@@ -133,9 +135,7 @@ def complete(scene, path, out_dir, log=print):
         raise ProcedureError(str(e))
     done["procedure"] = copy.deepcopy(scene["procedure"])
     base = done["balloon"]["mesh"]
-    pts = [[float(v) for v in line.split()] for line in Path(base["centerline"]["file"]).read_text().splitlines()
-           if line.strip() and not line.lstrip().startswith("#")]
-    length = sum(math.dist(a, b) for a, b in zip(pts, pts[1:]))
+    length = float(arc_length(np.loadtxt(base["centerline"]["file"]))[-1])  # the file the pipeline wrote
     centre = base["start"] + 0.5 * float(base["length"])
     for k, ph in enumerate(done["procedure"]):
         m = ph.get("balloon", {}).get("mesh") if isinstance(ph, dict) and isinstance(ph.get("balloon"), dict) else None
@@ -262,9 +262,10 @@ def reference_area(before, mask):
     return sum(_area(x) for x in refs) / len(refs) if refs else None
 
 
-def phase_results(pdir, phase, before, mask):
+def phase_results(pdir, phase, before, stations, mask):
     """Per-phase figures from the phase's solid (and beam) summaries; `before`: the solid summary step
-    of the lumen before the procedure; mask: the treated stations (None: all)."""
+    of the lumen before the procedure; stations: the lumen stations (mm along the vessel); mask: the
+    treated stations (None: all)."""
     solid = _load(pdir / "solid" / "summary.json") or {}
     steps = [s for s in solid.get("steps", []) if _number(s.get("time"))]
     out = {"name": phase["name"], "start": phase["start"], "end": phase["end"], "stent": phase["stent"]}
@@ -290,7 +291,6 @@ def phase_results(pdir, phase, before, mask):
     # reference lumen area, IVUS' stent expansion (minimal stent area / reference lumen area; the
     # lumen inside the stent is the stent's area where the struts are apposed)
     ext = last.get("stent_stations")
-    stations = phase.get("_stations") or []
     if phase["stent"] and ext and stations:
         in_stent = [ext[0] <= z <= ext[1] for z in stations]
         d_in = _lumen_min(last, in_stent) if any(in_stent) else None
@@ -336,7 +336,7 @@ def summarize(run_dir, scene, path, ran):
     out["segment"] = ("stations covered by the procedure's devices (balloons and stent)" if mask
                       else "all stations (a device extent is not known)")
     for k, ph, status, wall in ran:
-        r = phase_results(phase_dir(run_dir, k, ph), {**ph, "_stations": stations}, before, mask)
+        r = phase_results(phase_dir(run_dir, k, ph), ph, before, stations, mask)
         r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
         out["phases"].append(r)
     (run_dir / "procedure.json").write_text(json.dumps(out, indent=1) + "\n")
