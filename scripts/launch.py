@@ -215,13 +215,16 @@ def install_prepared(prepared, run_dir):
     return path
 
 
-def free_tcp_port():
+def free_tcp_port(host="127.0.0.1"):
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
+        s.bind((host, 0))
         return s.getsockname()[1]
 
 
 def pick_endpoint(run_dir, transport):
+    if transport == "auto" and in_slurm_allocation() and int(os.environ.get("SLURM_JOB_NUM_NODES", "1")) > 1:
+        # ranks on other nodes cannot reach a unix socket or the loopback of this one
+        return f"tcp/{socket.gethostbyname(socket.gethostname())}:{free_tcp_port('0.0.0.0')}"
     sock = (run_dir / "coupler.sock").resolve()
     if transport == "unix" or (transport == "auto" and len(str(sock)) <= UNIX_PATH_MAX - 1):
         if len(str(sock)) > UNIX_PATH_MAX - 1:
@@ -230,6 +233,33 @@ def pick_endpoint(run_dir, transport):
             sock.unlink()
         return f"unixsock-stream/{sock}"
     return f"tcp/127.0.0.1:{free_tcp_port()}"
+
+
+def in_slurm_allocation():
+    return bool(os.environ.get("SLURM_JOB_ID")) and shutil.which("srun") is not None
+
+
+def mpi_command(launcher, ranks):
+    """How the solid's ranks start: mpirun on a workstation; srun inside a Slurm allocation (a job
+    or an array task of scripts/study.py), so that Slurm places the ranks on the allocated cores and
+    nodes. srun's MPI plugin is SLURM_MPI_TYPE if set, else pmix (Debian's Open MPI and Slurm)."""
+    if launcher == "auto":
+        launcher = "srun" if in_slurm_allocation() else "mpirun"
+    if launcher == "srun":
+        if shutil.which("srun") is None:
+            die("--mpi-launcher srun: srun not found on PATH")
+        return ["srun", f"--mpi={os.environ.get('SLURM_MPI_TYPE') or 'pmix'}", "--ntasks", str(ranks),
+                "--input", "none", "--kill-on-bad-exit=1"]
+    cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", "--bind-to", "none"]
+    if os.geteuid() == 0:
+        cmd.append("--allow-run-as-root")
+    return cmd
+
+
+def endpoint_arg(text):
+    if not re.fullmatch(r"tcp/[A-Za-z0-9._-]+:[0-9]{1,5}", text):
+        raise argparse.ArgumentTypeError(f"expected tcp/HOST:PORT, got {text!r}")
+    return text
 
 
 def find_binary(build_dir, name):
@@ -491,9 +521,11 @@ def run_procedure(scene, scene_path, scene_text, args):
     for opt in ("record", "run_id", "beam_cmd", "solid_cmd"):
         if getattr(args, opt):
             die(f"--{opt.replace('_', '-')}: not supported for a procedure (a scene with `procedure:`)")
-    passed = ["--build-dir", args.build_dir, "--transport", args.transport, "--log-level", args.log_level]
+    passed = ["--build-dir", args.build_dir, "--transport", args.transport, "--mpi-launcher", args.mpi_launcher,
+              "--log-level", args.log_level]
     passed += (["--ranks", str(args.ranks)] if args.ranks is not None else []) + (["--verbose"] if args.verbose else [])
     passed += ["--timeout", str(args.timeout)] if args.timeout is not None else []
+    passed += ["--endpoint", args.endpoint] if args.endpoint else []
     try:
         if args.check:
             procedure.check(scene, scene_path, passed)
@@ -522,7 +554,14 @@ def main():
                     "refused while another launch uses it")
     ap.add_argument("--build-dir", default=str(ROOT / "build"), help="CMake build directory")
     ap.add_argument("--ranks", type=ranks_arg, help="MPI ranks of the solid solver (overrides solid.ranks)")
-    ap.add_argument("--transport", choices=["auto", "unix", "tcp"], default="auto")
+    ap.add_argument("--transport", choices=["auto", "unix", "tcp"], default="auto",
+                    help="auto: a unix socket in the run directory, tcp on this host's address when a "
+                         "Slurm allocation spans nodes (the solid's ranks may start elsewhere)")
+    ap.add_argument("--endpoint", type=endpoint_arg,
+                    help="the coupler's zenoh endpoint, e.g. tcp/10.0.0.1:7447 (default: chosen by --transport); "
+                         "for participants on other hosts or network namespaces")
+    ap.add_argument("--mpi-launcher", choices=["auto", "mpirun", "srun"], default="auto",
+                    help="how the solid's ranks start (auto: srun inside a Slurm allocation, else mpirun)")
     ap.add_argument("--record", action="store_true", help="record all exchanges (coupled scenes)")
     ap.add_argument("--timeout", type=float,
                     help="peer silence timeout, s (default: the executables' own, `coupler --help`)")
@@ -572,9 +611,7 @@ def main():
     prepared = prepare_patient(scene, scene_path) if "patient" in scene else None
 
     build = Path(args.build_dir).resolve()
-    mpirun = ["mpirun", "-n", str(ranks), "--oversubscribe", "--bind-to", "none"]
-    if os.geteuid() == 0:
-        mpirun.append("--allow-run-as-root")
+    mpirun = mpi_command(args.mpi_launcher, ranks)
     beam_exe = solid_exe = coupler_exe = None
     if has_stent:
         beam_exe = command_arg("--beam-cmd", args.beam_cmd) if args.beam_cmd else [find_binary(build, "beam_solver")]
@@ -622,7 +659,7 @@ def main():
     plan = []
     if has_stent and has_solid:
         write_run_key(run_dir / "run.key")
-        endpoint = pick_endpoint(run_dir, args.transport)
+        endpoint = args.endpoint or pick_endpoint(run_dir, args.transport)
         coupled = ["--endpoint", endpoint, "--run-id", run_id]
         coupler = coupler_exe + common + coupled + (["--record"] if args.record else [])
         plan = [("coupler", coupler), ("beam_solver", beam_exe + common + coupled),
@@ -633,7 +670,8 @@ def main():
         plan = [("solid_solver", solid_exe + common)]
 
     print(f"launch: run directory {run_dir}")
-    print("launch: processes: " + ", ".join(name for name, _ in plan))
+    via = f" ({ranks} rank{'s' if ranks > 1 else ''} via {mpirun[0]})" if has_solid and not args.solid_cmd else ""
+    print("launch: processes: " + ", ".join(name + (via if name == "solid_solver" else "") for name, _ in plan))
     procs = []
     interrupted = {"sig": None}
 

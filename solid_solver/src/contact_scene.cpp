@@ -95,13 +95,16 @@ ContactSpec read_contact_spec(const Node& root) {
     if (disabled(*n)) {
       spec.balloon_artery.reset();
     } else {
-      n->check_keys({"penalty", "quadrature", "two_pass", "from"});
+      n->check_keys({"penalty", "quadrature", "regularization", "two_pass", "from"});
       auto& o = *spec.balloon_artery;
       o.from = read_from(*n);
       o.penalty = n->positive_or("penalty", o.penalty);
       o.quadrature = int(n->integer_or("quadrature", o.quadrature, 1));
       if (o.quadrature > 7) n->child("quadrature").fail("a quadrature degree between 1 and 7");
       o.two_pass = n->boolean_or("two_pass", o.two_pass);
+      o.regularization = n->non_negative_or("regularization", o.regularization);
+      if (!(o.regularization < 0.5 * spec.search_radius))
+        n->child("regularization").fail("a value below half of contact.search_radius (mm)");
     }
   }
   if (spec.balloon_artery) spec.balloon_artery->search_radius = spec.search_radius;

@@ -237,6 +237,7 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
     contact::SurfaceContactParams par;
     par.penalty = opt_.penalty;
     par.quadrature_degree = opt_.quadrature;
+    par.regularization = opt_.regularization;
     par.two_pass = opt_.two_pass;
     par.compute_tangent = K != nullptr;
     const auto res = contact::evaluate_surface_contact(*ss_, *sm_, par);

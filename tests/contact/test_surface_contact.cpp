@@ -1,6 +1,8 @@
 // Surface-to-surface (Gauss-point-to-segment) penalty contact.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "helpers.hpp"
 
 using namespace angio::contact;
@@ -94,7 +96,7 @@ TEST(SurfaceContact, TwoPassParallelPatches) {
 namespace {
 // Sum of the Gauss point kernels of one slave face against one master face.
 Eigen::VectorXd pair_residual(FaceKind sk, const FaceX& Xs, FaceKind mk, const FaceX& Xm, double msign, double eps,
-                              Eigen::MatrixXd* K, std::vector<Location>* locs) {
+                              double g0, Eigen::MatrixXd* K, std::vector<Location>* locs) {
   const QuadratureRule rule = face_rule(sk, 3);
   const int m = 3 * (Xs.cols() + Xm.cols());
   Eigen::VectorXd r = Eigen::VectorXd::Zero(m);
@@ -106,18 +108,29 @@ Eigen::VectorXd pair_residual(FaceKind sk, const FaceX& Xs, FaceKind mk, const F
     if (locs) locs->push_back(p.location);
     Eigen::VectorXd rq;
     Eigen::MatrixXd Kq;
-    surface_gp_kernel(sk, Xs, rule.xi[q], rule.w[q], mk, Xm, msign, p, eps, rq, K ? &Kq : nullptr);
+    surface_gp_kernel(sk, Xs, rule.xi[q], rule.w[q], mk, Xm, msign, p, eps, g0, rq, K ? &Kq : nullptr);
     r += rq;
     if (K) *K += Kq;
   }
   return r;
 }
 
-void check_pair(FaceKind sk, const FaceX& Xs, FaceKind mk, const FaceX& Xm, double msign) {
+// A distorted quad slave over the master quad W, node a shifted by (0.01 a, -0.005 a, z0 + dz a).
+FaceX distorted_slave(const FaceX& W, double z0, double dz) {
+  FaceX S(3, 4);
+  S.col(0) = evaluate(FaceKind::Quad4, W, Vec2(-0.5, -0.4)).x;
+  S.col(1) = evaluate(FaceKind::Quad4, W, Vec2(-0.4, 0.5)).x;
+  S.col(2) = evaluate(FaceKind::Quad4, W, Vec2(0.6, 0.4)).x;
+  S.col(3) = evaluate(FaceKind::Quad4, W, Vec2(0.5, -0.5)).x;
+  for (int a = 0; a < 4; ++a) S.col(a) += Vec3(0.01 * a, -0.005 * a, z0 + dz * a);
+  return S;
+}
+
+void check_pair(FaceKind sk, const FaceX& Xs, FaceKind mk, const FaceX& Xm, double msign, double g0 = 0.0) {
   const double eps = 5.0;
   Eigen::MatrixXd K;
   std::vector<Location> locs;
-  const Eigen::VectorXd r = pair_residual(sk, Xs, mk, Xm, msign, eps, &K, &locs);
+  const Eigen::VectorXd r = pair_residual(sk, Xs, mk, Xm, msign, eps, g0, &K, &locs);
   ASSERT_GT(r.norm(), 0.0);
   const int ns = static_cast<int>(Xs.cols());
   Eigen::VectorXd u(r.size());
@@ -126,7 +139,7 @@ void check_pair(FaceKind sk, const FaceX& Xs, FaceKind mk, const FaceX& Xm, doub
   auto f = [&](const Eigen::VectorXd& v) {
     std::vector<Location> l2;
     const Eigen::VectorXd rr = pair_residual(sk, unflatten(v.head(3 * ns)), mk, unflatten(v.tail(v.size() - 3 * ns)),
-                                             msign, eps, nullptr, &l2);
+                                             msign, eps, g0, nullptr, &l2);
     EXPECT_EQ(l2, locs);
     return rr;
   };
@@ -145,12 +158,7 @@ void check_pair(FaceKind sk, const FaceX& Xs, FaceKind mk, const FaceX& Xm, doub
 TEST(SurfaceContact, TangentMatchesFiniteDifferences) {
   // master: warped quad, normal +-; slave: smaller distorted quad slightly below the master, facing it
   const FaceX W = warped_quad();
-  FaceX S(3, 4);
-  S.col(0) = evaluate(FaceKind::Quad4, W, Vec2(-0.5, -0.4)).x;
-  S.col(1) = evaluate(FaceKind::Quad4, W, Vec2(-0.4, 0.5)).x;
-  S.col(2) = evaluate(FaceKind::Quad4, W, Vec2(0.6, 0.4)).x;
-  S.col(3) = evaluate(FaceKind::Quad4, W, Vec2(0.5, -0.5)).x;
-  for (int a = 0; a < 4; ++a) S.col(a) += Vec3(0.01 * a, -0.005 * a, -0.02 - 0.01 * a);  // below the master (+n side is up)
+  const FaceX S = distorted_slave(W, -0.02, -0.01);  // below the master (+n side is up)
   check_pair(FaceKind::Quad4, S, FaceKind::Quad4, W, 1.0);
   // tri6 slave on a cylinder of radius 0.98 against a tri6 master of radius 1 seen from inside (normal -e_r)
   const FaceX Tm = cylinder_tri6(1.0);
@@ -166,6 +174,45 @@ TEST(SurfaceContact, TangentMatchesFiniteDifferences) {
   FaceX Q(3, 4);
   Q << 0, 0.5, 0.5, 0, 0, 0, 0.5, 0.5, -0.03, -0.02, -0.01, -0.04;
   check_pair(FaceKind::Quad4, Q, FaceKind::Tri3, T3, 1.0);
+}
+
+// Compares against: central finite differences (as above) with the C1 regularized law, the slave tilted so
+// that its Gauss points lie on both sides of g = 0 (linear and quadratic branches of the law).
+TEST(SurfaceContact, RegularizedTangentMatchesFiniteDifferences) {
+  const FaceX W = warped_quad();
+  const FaceX S = distorted_slave(W, 0.012, -0.012);  // gaps about +0.01 .. -0.025
+  std::vector<double> gaps;
+  const QuadratureRule rule = face_rule(FaceKind::Quad4, 3);
+  for (const auto& xi : rule.xi) {
+    ShapeN N;
+    shape(FaceKind::Quad4, xi, N);
+    gaps.push_back(project(FaceKind::Quad4, W, 1.0, S * N).d);
+  }
+  ASSERT_LT(*std::min_element(gaps.begin(), gaps.end()), 0.0);
+  ASSERT_GT(*std::max_element(gaps.begin(), gaps.end()), 0.0);
+  ASSERT_LT(*std::max_element(gaps.begin(), gaps.end()), 0.03);
+  check_pair(FaceKind::Quad4, S, FaceKind::Quad4, W, 1.0, 0.03);
+}
+
+// Compares against: the closed form of the regularized law for two parallel flat patches apart by a gap
+// 0 < g < g0: pressure eps (g0 - g)^2 / (2 g0) everywhere, total force that times the overlap area;
+// at g >= g0 nothing is active.
+TEST(SurfaceContact, RegularizedParallelPatchesExactPressure) {
+  const double eps = 5.0, g0 = 0.04, gap = 0.01;
+  TwoPatches t = two_patches(0.5, 1.5, 0.3, 1.7, 3, 5, -gap);
+  SurfaceSearch Ss(t.slave, 0.1), Sm(t.master, 0.1);
+  Ss.update(t.all.x);
+  Sm.update(t.all.x);
+  SurfaceContactParams par;
+  par.penalty = eps;
+  par.regularization = g0;
+  const SurfaceContactResult r = evaluate_surface_contact(Ss, Sm, par);
+  const double p = eps * (g0 - gap) * (g0 - gap) / (2.0 * g0), area = 1.0 * 1.4;
+  EXPECT_EQ(r.diag.num_active, 15 * 4);
+  for (const auto& gp : r.points) EXPECT_NEAR(gp.pressure, p, 1e-14);
+  EXPECT_NEAR(r.diag.force_on_solid.z(), -p * area, 1e-13);
+  par.regularization = 0.5 * gap;
+  EXPECT_EQ(evaluate_surface_contact(Ss, Sm, par).diag.num_active, 0);
 }
 
 // Compares against: the analytic penetration of a balloon-like tube (slave, outer radius 1.02) inside an

@@ -2,17 +2,21 @@
 
 #include <cmath>
 
+#include "angio/participant/penalty_law.hpp"
+
 namespace angio::contact {
 
 double surface_gp_kernel(FaceKind sk, const FaceX& Xs, const Vec2& xi_g, double w_g, FaceKind mk, const FaceX& Xm,
-                         double master_sign, const Projection& proj, double eps, Eigen::VectorXd& r,
+                         double master_sign, const Projection& proj, double eps, double g0, Eigen::VectorXd& r,
                          Eigen::MatrixXd* K) {
   const int ns = num_nodes(sk), nm = num_nodes(mk);
   const int ms = 3 * ns, mm = 3 * nm, m = ms + mm;
   r.setZero(m);
   if (K) K->setZero(m, m);
   const double g = proj.d;
-  if (!(g < 0.0)) return g;
+  if (!(g < std::max(g0, 0.0))) return g;
+  // potential per area pi(g), pressure f = -pi'(g), stiffness k = pi''(g)
+  const participant::PenaltyLaw law = participant::penalty_law(g, g0, eps);
 
   ShapeN Ns;
   ShapeD dNs;
@@ -38,8 +42,8 @@ double surface_gp_kernel(FaceKind sk, const FaceX& Xs, const Vec2& xi_g, double 
     dW.segment<3>(3 * a) = w_g * (-dNs(a, 0) * nu.cross(a2) + dNs(a, 1) * nu.cross(a1)).transpose();
     Dn.block<3, 3>(0, 3 * a) = d_area_vector(dNs(a, 0), dNs(a, 1), a1, a2);
   }
-  // Pi = W eps/2 g^2
-  r = (0.5 * eps * g * g) * dW.transpose() + (W * eps * g) * dg.transpose();
+  // Pi = W pi(g): r = pi dW + W pi' dg
+  r = law.pi * dW.transpose() - (W * law.f) * dg.transpose();
   if (!K) return g;
 
   // d2g/du2 from the x-X Hessian of d with x = sum_a N_a X^s_a
@@ -61,8 +65,9 @@ double surface_gp_kernel(FaceKind sk, const FaceX& Xs, const Vec2& xi_g, double 
       d2W.block<3, 3>(3 * a, 3 * b) += (dNs(a, 1) * dNs(b, 0) - dNs(a, 0) * dNs(b, 1)) * S;
   d2W *= w_g;
 
-  *K = (0.5 * eps * g * g) * d2W + (eps * g) * (dW.transpose() * dg + dg.transpose() * dW) +
-       (W * eps) * (dg.transpose() * dg + g * d2g);
+  // K = pi d2W + pi' (dW^T dg + dg^T dW) + W (pi'' dg^T dg + pi' d2g)
+  *K = law.pi * d2W - law.f * (dW.transpose() * dg + dg.transpose() * dW) +
+       W * (law.k * (dg.transpose() * dg) - law.f * d2g);
   return g;
 }
 
@@ -95,15 +100,16 @@ void one_pass(int pass, const SurfaceSearch& slave, const SurfaceSearch& master,
       gp.gap = sp.proj.d;
       gp.area = W;
       gp.location = sp.proj.location;
-      gp.active = gp.gap < 0.0;
-      gp.pressure = gp.active ? -eps * gp.gap : 0.0;
+      gp.active = gp.gap < par.regularization;
+      const participant::PenaltyLaw law = participant::penalty_law(gp.gap, par.regularization, eps);
+      gp.pressure = gp.active ? law.f : 0.0;
       ++res.diag.num_points;
       res.diag.min_gap = std::min(res.diag.min_gap, gp.gap);
       if (gp.active) {
         ++res.diag.num_active;
         NodalContribution nc;
         surface_gp_kernel(sf.kind, Xs, rule.xi[q], rule.w[q], mf.kind, master.face_coords(sp.face), ms.normal_sign,
-                          sp.proj, eps, nc.r, par.compute_tangent ? &nc.K : nullptr);
+                          sp.proj, eps, par.regularization, nc.r, par.compute_tangent ? &nc.K : nullptr);
         nc.nodes.assign(sf.nodes.begin(), sf.nodes.begin() + sf.nn());
         nc.nodes.insert(nc.nodes.end(), mf.nodes.begin(), mf.nodes.begin() + mf.nn());
         nc.surface = pass;
@@ -111,7 +117,7 @@ void one_pass(int pass, const SurfaceSearch& slave, const SurfaceSearch& master,
         const Vec3 f_master = gp.pressure * W * (-gp.n);  // force on the master side of this pair
         res.diag.force_on_solid += pass == 0 ? f_master : Vec3(-f_master);
         res.diag.force_magnitude += gp.pressure * W;
-        res.diag.energy += 0.5 * W * eps * gp.gap * gp.gap;
+        res.diag.energy += W * law.pi;
         res.active_area += W;
         res.contributions.push_back(std::move(nc));
       }

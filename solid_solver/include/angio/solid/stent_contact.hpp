@@ -107,6 +107,7 @@ class PenaltySurfaceContact : public ContactModel {
   struct Options {
     double penalty = 5.0;      // N/mm^3 (pressure per penetration)
     int quadrature = 3;        // slave face rule degree (3: quad 2x2)
+    double regularization = 0.0;  // mm: C1 law active below this gap (contact::SurfaceContactParams)
     bool two_pass = false;
     double search_radius = 0.3;
     std::string slave = "balloon_outer";

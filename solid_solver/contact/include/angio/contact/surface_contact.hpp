@@ -4,6 +4,9 @@
 // Per slave Gauss point x = sum_a N_a(xi_g) X^s_a with weight W = w_g j(xi_g) (CURRENT area, j = |x_,xi x x_,eta|):
 //   s, n = closest point on the master surface and its contact normal (toward the slave)
 //   g_N  = (x - s) . n,    Pi = W eps/2 <g_N>^2,    traction on the slave t = -eps <g_N> n (pressure p = -eps <g_N>)
+//   or, with a regularization g0 > 0, Pi = W pi(g_N) with the C1 linear-quadratic law of the line contact
+//   (participant/penalty_law.hpp: pressure zero at g_N = g0, quadratic up to 0, linear beyond), so that a
+//   Gauss point entering or leaving contact changes the force and the tangent continuously
 //   r    = dPi/du, K = d2Pi/du2 with u = [slave face nodes, master face nodes]
 // (includes the variation of the current area, of the closest point and of the master normal).
 // Forces on the nodes are -r; slave and master forces balance exactly.
@@ -17,6 +20,7 @@ namespace angio::contact {
 struct SurfaceContactParams {
   double penalty = 5.0;          // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see solid_solver/contact/README.md
   int quadrature_degree = 3;     // slave quadrature (face_rule): quad 2x2, tri 6 points
+  double regularization = 0.0;   // g0 (mm): C1 law, active where g_N < g0; 0: the paper's quadratic potential
   bool two_pass = false;         // symmetric: both surfaces act as slave, each pass with eps/2
   bool compute_tangent = true;
   ProjectionOptions projection;
@@ -30,7 +34,7 @@ struct GaussPointContact {
   Vec3 s = Vec3::Zero();   // closest point on the master
   Vec3 n = Vec3::Zero();   // master contact normal
   double gap = 0.0;        // g_N
-  double pressure = 0.0;   // -eps <g_N> (MPa)
+  double pressure = 0.0;   // contact pressure (MPa): -eps <g_N>, or the regularized law's
   double area = 0.0;       // W = w_g j (mm^2)
   bool active = false;
   Location location = Location::Interior;
@@ -44,9 +48,9 @@ struct SurfaceContactResult {
 };
 
 // Pure kernel for one slave Gauss point whose master projection is known.
-// r (3(ns+nm)) and K (if non-null) are overwritten; returns g_N.
+// r (3(ns+nm)) and K (if non-null) are overwritten; returns g_N. g0: the regularization (0: none).
 double surface_gp_kernel(FaceKind slave_kind, const FaceX& Xs, const Vec2& xi_g, double w_g, FaceKind master_kind,
-                         const FaceX& Xm, double master_sign, const Projection& proj, double penalty,
+                         const FaceX& Xm, double master_sign, const Projection& proj, double penalty, double g0,
                          Eigen::VectorXd& r, Eigen::MatrixXd* K);
 
 // Evaluate contact of `slave` against `master` (both searches update()d with the current coordinates;
