@@ -56,14 +56,19 @@ def main():
         sys.exit(f"balloon_axis_bow: {scene_path}: balloon.mesh.centerline: expected {{file: ...}} (a curved balloon)")
     # the launcher's scene.yaml keeps the user's relative paths; they resolve against configs/
     path = cl["file"]
-    for base in (os.path.dirname(scene_path), os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "configs")):
+    for base in (
+        os.path.dirname(scene_path),
+        os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "configs"),
+    ):
         if os.path.isfile(os.path.join(base, path)):
             path = os.path.join(base, path)
             break
     line = np.loadtxt(path)
     with h5py.File(os.path.join(args.run_dir, "solid", "solid.h5"), "r") as f:
         X = f["mesh/coordinates"][:]
-        blocks = {b["id"]: b["name"] for b in json.load(open(os.path.join(args.run_dir, "solid", "summary.json")))["blocks"]}
+        blocks = {
+            b["id"]: b["name"] for b in json.load(open(os.path.join(args.run_dir, "solid", "summary.json")))["blocks"]
+        }
         nodes = set()
         for typ in f["mesh"]:
             if isinstance(f["mesh"][typ], h5py.Group) and "block_id" in f["mesh"][typ]:
@@ -74,11 +79,19 @@ def main():
         nodes = np.array(sorted(nodes))
         s = arc_length_of(X[nodes], line)
         lo, hi = s.min(), s.max()
-        stations = {"end0": lo + args.offset, "q0": lo + 0.25 * (hi - lo), "mid": 0.5 * (lo + hi),
-                    "q1": lo + 0.75 * (hi - lo), "end1": hi - args.offset}
+        stations = {
+            "end0": lo + args.offset,
+            "q0": lo + 0.25 * (hi - lo),
+            "mid": 0.5 * (lo + hi),
+            "q1": lo + 0.75 * (hi - lo),
+            "end1": hi - args.offset,
+        }
         width = 0.3
         groups = {k: nodes[np.abs(s - v) < width] for k, v in stations.items()}
-        print(f"# {args.run_dir}: balloon arc length {hi - lo:.2f} mm, stations {', '.join(f'{k} {v - lo:.2f}' for k, v in stations.items())}")
+        print(
+            f"# {args.run_dir}: balloon arc length {hi - lo:.2f} mm, stations "
+            + ", ".join(f"{k} {v - lo:.2f}" for k, v in stations.items())
+        )
         print(f"{'time':>8} {'whole R':>9} {'half 0 R':>9} {'half 1 R':>9} {'chord':>8}")
         steps = sorted(f["steps"], key=int)
         for k in steps:
@@ -86,9 +99,12 @@ def main():
             x = X + g["displacement"][:]
             c = {n: x[idx].mean(axis=0) for n, idx in groups.items()}
             t = float(g.attrs["time"])
-            print(f"{t:8.3f} {circle_radius(c['end0'], c['mid'], c['end1']):9.2f} "
-                  f"{circle_radius(c['end0'], c['q0'], c['mid']):9.2f} {circle_radius(c['mid'], c['q1'], c['end1']):9.2f} "
-                  f"{np.linalg.norm(c['end1'] - c['end0']):8.3f}")
+            print(
+                f"{t:8.3f} {circle_radius(c['end0'], c['mid'], c['end1']):9.2f} "
+                f"{circle_radius(c['end0'], c['q0'], c['mid']):9.2f} "
+                f"{circle_radius(c['mid'], c['q1'], c['end1']):9.2f} "
+                f"{np.linalg.norm(c['end1'] - c['end0']):8.3f}"
+            )
 
 
 if __name__ == "__main__":

@@ -44,15 +44,18 @@ def main():
             with open(scene, "w") as f:
                 f.write(SCENE.format(steps=a.steps, rings=a.rings, solver=solver))
             run = os.path.join(tmp, f"run_{solver}")
-            r = subprocess.run([a.exe, "--scene", scene, "--run-dir", run, "--log-level", "warn"],
-                               capture_output=True, text=True)
+            r = subprocess.run(
+                [a.exe, "--scene", scene, "--run-dir", run, "--log-level", "warn"], capture_output=True, text=True
+            )
             if r.returncode != 0:
                 print(r.stdout, r.stderr, file=sys.stderr)
                 sys.exit(f"beam_solver failed with {solver}")
             s = json.load(open(os.path.join(run, "beam", "summary.json")))
-            print(f"{solver:9s} elements {s['num_elements']:5d}  iterations {s['newton_iterations_total']:4d}  "
-                  f"{1e3 * s['seconds_per_newton_iteration']:7.2f} ms/iteration  "
-                  f"D(t=0.5) = {s['diameter']['final']:.4f} mm")
+            print(
+                f"{solver:9s} elements {s['num_elements']:5d}  iterations {s['newton_iterations_total']:4d}  "
+                f"{1e3 * s['seconds_per_newton_iteration']:7.2f} ms/iteration  "
+                f"D(t=0.5) = {s['diameter']['final']:.4f} mm"
+            )
 
 
 if __name__ == "__main__":

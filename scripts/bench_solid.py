@@ -8,10 +8,18 @@ Runs the scene with `time.steps` and `time.end` scaled to the given number of st
 option string, reads <run>/solid/summary.json and prints seconds per Newton iteration (total step
 wall time incl. assembly and output / Newton iterations).
 """
-import argparse, json, os, re, subprocess, sys, tempfile, time
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
 
 SOLVERS = {
-    "gmres+bjacobi-ilu1": "-ksp_type gmres -ksp_gmres_restart 200 -pc_type bjacobi -sub_pc_type ilu -sub_pc_factor_levels 1",
+    "gmres+bjacobi-ilu1": "-ksp_type gmres -ksp_gmres_restart 200 -pc_type bjacobi -sub_pc_type ilu "
+    "-sub_pc_factor_levels 1",
     "mumps-lu": "-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps",
     "gmres+gamg": "-ksp_type gmres -ksp_gmres_restart 200 -pc_type gamg -pc_gamg_threshold 0.01",
     "gmres+hypre": "-ksp_type gmres -ksp_gmres_restart 200 -pc_type hypre -pc_hypre_type boomeramg",
@@ -40,14 +48,29 @@ def main():
     for ranks in a.ranks:
         for name in a.solvers:
             opts = SOLVERS.get(name, name)
-            t = re.sub(r'petsc_options:.*', f'petsc_options: "{opts}"', text)
+            t = re.sub(r"petsc_options:.*", f'petsc_options: "{opts}"', text)
             with tempfile.TemporaryDirectory() as d:
                 scene = os.path.join(os.path.dirname(os.path.abspath(a.scene)), f".bench_{os.getpid()}.yaml")
                 open(scene, "w").write(t)
                 try:
                     t0 = time.time()
-                    r = subprocess.run(["mpirun", "--allow-run-as-root", "--oversubscribe", "-n", str(ranks), a.exe,
-                                        "--scene", scene, "--run-dir", d], env=env, capture_output=True, text=True)
+                    r = subprocess.run(
+                        [
+                            "mpirun",
+                            "--allow-run-as-root",
+                            "--oversubscribe",
+                            "-n",
+                            str(ranks),
+                            a.exe,
+                            "--scene",
+                            scene,
+                            "--run-dir",
+                            d,
+                        ],
+                        env=env,
+                        capture_output=True,
+                        text=True,
+                    )
                     wall = time.time() - t0
                 finally:
                     os.remove(scene)

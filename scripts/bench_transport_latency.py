@@ -19,8 +19,10 @@ from pathlib import Path
 
 
 def find_bench(build_dir: Path) -> Path:
-    candidates = [build_dir / "bin" / "transport_latency_bench",
-                  build_dir / "protocol" / "transport" / "transport_latency_bench"]
+    candidates = [
+        build_dir / "bin" / "transport_latency_bench",
+        build_dir / "protocol" / "transport" / "transport_latency_bench",
+    ]
     for c in candidates:
         if c.is_file() and os.access(c, os.X_OK):
             return c
@@ -28,8 +30,10 @@ def find_bench(build_dir: Path) -> Path:
     found = [f for f in found if f.is_file() and os.access(f, os.X_OK)]
     if found:
         return found[0]
-    sys.exit(f"transport_latency_bench not found under {build_dir}; build the target first "
-             f"(cmake --build {build_dir} --target transport_latency_bench)")
+    sys.exit(
+        f"transport_latency_bench not found under {build_dir}; build the target first "
+        f"(cmake --build {build_dir} --target transport_latency_bench)"
+    )
 
 
 def free_tcp_port() -> int:
@@ -40,13 +44,34 @@ def free_tcp_port() -> int:
 
 def run_pair(bench: Path, label: str, endpoint: str, args) -> list:
     key = f"angio/bench-{os.getpid()}/{label}/echo"
-    server = subprocess.Popen([str(bench), "server", "--listen", endpoint, "--key", key],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    server = subprocess.Popen(
+        [str(bench), "server", "--listen", endpoint, "--key", key],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         client = subprocess.run(
-            [str(bench), "client", "--connect", endpoint, "--key", key, "--vectors", args.vectors,
-             "--rounds", str(args.rounds), "--warmup", str(args.warmup), "--label", label],
-            capture_output=True, text=True, timeout=args.timeout)
+            [
+                str(bench),
+                "client",
+                "--connect",
+                endpoint,
+                "--key",
+                key,
+                "--vectors",
+                args.vectors,
+                "--rounds",
+                str(args.rounds),
+                "--warmup",
+                str(args.warmup),
+                "--label",
+                label,
+            ],
+            capture_output=True,
+            text=True,
+            timeout=args.timeout,
+        )
         if client.returncode != 0:
             sys.exit(f"{label}: client failed ({client.returncode}): {client.stderr.strip()}")
         results = [json.loads(line) for line in client.stdout.splitlines() if line.startswith("{")]
@@ -80,11 +105,15 @@ def main() -> int:
         for r in results:
             print(json.dumps(r))
         return 0
-    print(f"{'transport':<10}{'3-vectors':>10}{'bytes':>9}{'round trips':>13}"
-          f"{'median us':>11}{'p90 us':>10}{'min us':>10}")
+    print(
+        f"{'transport':<10}{'3-vectors':>10}{'bytes':>9}{'round trips':>13}"
+        f"{'median us':>11}{'p90 us':>10}{'min us':>10}"
+    )
     for r in results:
-        print(f"{r['transport']:<10}{r['vectors']:>10}{r['bytes']:>9}{r['round_trips']:>13}"
-              f"{r['median_us']:>11.1f}{r['p90_us']:>10.1f}{r['min_us']:>10.1f}")
+        print(
+            f"{r['transport']:<10}{r['vectors']:>10}{r['bytes']:>9}{r['round_trips']:>13}"
+            f"{r['median_us']:>11.1f}{r['p90_us']:>10.1f}{r['min_us']:>10.1f}"
+        )
     return 0
 
 

@@ -43,8 +43,19 @@ UNIX_PATH_MAX = 107
 # The top-level sections some executable reads (docs/user-guide.md "Scenes"). The launcher picks the processes
 # from these keys, so a misspelt one must stop the launch instead of silently running another
 # simulation (a scene without its `stent` runs the balloon alone).
-SECTIONS = ("time", "load_curves", "output", "stent", "balloon", "artery", "solid", "contact", "coupling", "patient",
-            "procedure")
+SECTIONS = (
+    "time",
+    "load_curves",
+    "output",
+    "stent",
+    "balloon",
+    "artery",
+    "solid",
+    "contact",
+    "coupling",
+    "patient",
+    "procedure",
+)
 # Catches typos (-n 2000 oversubscribes the machine into the ground) without limiting real runs.
 MAX_RANKS = 256
 # The run id is a chunk of the zenoh key expressions angio/<run_id>/...: '/' would shift the chunks
@@ -61,7 +72,7 @@ def die(msg, code=2):
 def shown(v, n=60):
     """repr(v) cut to n characters: a message stays one readable line whatever the value."""
     r = repr(v)
-    return r if len(r) <= n else r[:n - 3] + "..."
+    return r if len(r) <= n else r[: n - 3] + "..."
 
 
 class DuplicateKey(Exception):
@@ -176,8 +187,13 @@ def check_scene_with(name, exe, scene_path):
     """Runs `exe --scene S --check`: exit 2 with the executable's own message (file, key) if the
     scene is bad."""
     try:
-        r = subprocess.run(exe + ["--scene", str(scene_path), "--check", "--log-level", "error"],
-                           capture_output=True, text=True, errors="replace", timeout=600)
+        r = subprocess.run(
+            exe + ["--scene", str(scene_path), "--check", "--log-level", "error"],
+            capture_output=True,
+            text=True,
+            errors="replace",
+            timeout=600,
+        )
     except (OSError, subprocess.TimeoutExpired) as e:
         die(f"cannot check the scene with {name}: {e}", code=1)
     if r.returncode == 0:
@@ -205,7 +221,7 @@ def install_prepared(prepared, run_dir):
         if isinstance(node, list):
             return [relocate(v) for v in node]
         if isinstance(node, str) and node.startswith(str(scratch)):
-            return str(dest) + node[len(str(scratch)):]
+            return str(dest) + node[len(str(scratch)) :]
         return node
 
     path = run_dir / "scene.yaml"
@@ -248,8 +264,15 @@ def mpi_command(launcher, ranks):
     if launcher == "srun":
         if shutil.which("srun") is None:
             die("--mpi-launcher srun: srun not found on PATH")
-        return ["srun", f"--mpi={os.environ.get('SLURM_MPI_TYPE') or 'pmix'}", "--ntasks", str(ranks),
-                "--input", "none", "--kill-on-bad-exit=1"]
+        return [
+            "srun",
+            f"--mpi={os.environ.get('SLURM_MPI_TYPE') or 'pmix'}",
+            "--ntasks",
+            str(ranks),
+            "--input",
+            "none",
+            "--kill-on-bad-exit=1",
+        ]
     cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", "--bind-to", "none"]
     if os.geteuid() == 0:
         cmd.append("--allow-run-as-root")
@@ -343,8 +366,10 @@ def lock_run_dir(run_dir):
     except BlockingIOError:
         f.seek(0)
         other = f.read().strip() or "?"
-        die(f"{run_dir}: expected a free run directory, got one in use by another launch (pid {other}); "
-            "pass another --run-dir")
+        die(
+            f"{run_dir}: expected a free run directory, got one in use by another launch (pid {other}); "
+            "pass another --run-dir"
+        )
     f.seek(0)
     f.truncate()
     f.write(f"{os.getpid()}\n")
@@ -357,8 +382,10 @@ def lock_run_dir(run_dir):
             with open(zlock) as z:
                 fcntl.flock(z, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            die(f"{run_dir}: expected a free run directory, got one in use by another launch "
-                "(a running coupler holds coupler.sock.lock); pass another --run-dir")
+            die(
+                f"{run_dir}: expected a free run directory, got one in use by another launch "
+                "(a running coupler holds coupler.sock.lock); pass another --run-dir"
+            )
         except OSError as e:
             die(f"{zlock}: cannot check the coupler's lock: {e.strerror}")
     return f
@@ -381,6 +408,7 @@ def die_with_launcher():
         prctl(PR_SET_PDEATHSIG, sig)
         if os.getppid() != parent:  # the launcher died before the prctl: no signal will come
             os._exit(128 + int(signal.SIGTERM))
+
     return preexec
 
 
@@ -393,9 +421,16 @@ class Proc:
         self.log = open(log_path, "w")
         # Own process group: Ctrl-C reaches the launcher only, which forwards it deliberately.
         # errors="replace": a byte that is not UTF-8 in a solver's output must not kill the pump.
-        self.p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                  start_new_session=True, preexec_fn=die_with_launcher(),
-                                  text=True, errors="replace", bufsize=1)
+        self.p = subprocess.Popen(
+            cmd,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+            preexec_fn=die_with_launcher(),
+            text=True,
+            errors="replace",
+            bufsize=1,
+        )
         self.t = threading.Thread(target=self._pump, daemon=True)
         self.t.start()
 
@@ -442,7 +477,7 @@ def last_error_line(log_path, limit=400):
     for ln in reversed(lines):
         if "ERROR" in ln:
             ln = " ".join(ln.split())
-            return ln if len(ln) <= limit else ln[:limit - 3] + "..."
+            return ln if len(ln) <= limit else ln[: limit - 3] + "..."
     return ""
 
 
@@ -463,6 +498,7 @@ def state_time(path):
     """The committed pseudo-time of a solver's state file (state_file.hpp), or exit 2 naming it."""
     try:
         import h5py
+
         with h5py.File(path, "r") as f:
             t = float(f.attrs["time"])
     except (OSError, KeyError, ValueError, ImportError) as e:
@@ -477,8 +513,10 @@ def resumed_scene(scene, scene_path, run_dir):
     states' time, the steps left at the scene's nominal increment, every part from its state. Written
     next to the scene as .<stem>.resume-<t>.yaml; returns its path."""
     if "procedure" in scene or "patient" in scene:
-        die(f"--resume: a {'procedure' if 'procedure' in scene else 'patient scene'} cannot be resumed yet; "
-            "continue it with solid.initial_state / stent.initial_state by hand")
+        die(
+            f"--resume: a {'procedure' if 'procedure' in scene else 'patient scene'} cannot be resumed yet; "
+            "continue it with solid.initial_state / stent.initial_state by hand"
+        )
     states = {}
     if "stent" in scene:
         states["beam"] = run_dir / "beam" / "state.h5"
@@ -490,12 +528,18 @@ def resumed_scene(scene, scene_path, run_dir):
     times = {k: state_time(p) for k, p in states.items()}
     t = next(iter(times.values()))
     if any(abs(v - t) > 1e-9 * max(1.0, abs(t)) for v in times.values()):
-        die(f"--resume {run_dir}: expected the solvers' state files at one time, got "
-            + ", ".join(f"{k} t = {v}" for k, v in times.items()) + " (the run stopped while they were written)")
+        die(
+            f"--resume {run_dir}: expected the solvers' state files at one time, got "
+            + ", ".join(f"{k} t = {v}" for k, v in times.items())
+            + " (the run stopped while they were written)"
+        )
     ts = dict(scene.get("time") or {})
     start, end, steps = float(ts.get("start", 0.0)), float(ts.get("end", 1.0)), int(ts.get("steps", 1))
     if not t < end - 1e-12 * max(1.0, abs(end)):
-        die(f"--resume {run_dir}: the states are at t = {t} s, the scene's end (time.end = {end} s): nothing left to run")
+        die(
+            f"--resume {run_dir}: the states are at t = {t} s, the scene's end (time.end = {end} s): "
+            "nothing left to run"
+        )
     ts.update(start=t, steps=max(1, round(steps * (end - t) / (end - start))))
     s = json.loads(json.dumps(scene))
     s["time"] = ts
@@ -505,8 +549,10 @@ def resumed_scene(scene, scene_path, run_dir):
         s.setdefault("solid", {})["initial_state"] = {"file": str(states["solid"])}
     path = scene_path.parent / f".{scene_path.stem}.resume-{t:g}.yaml"
     try:
-        path.write_text(f"# {scene_path.name} continued from {run_dir} at t = {t} s (launch.py --resume)\n"
-                        + yaml.safe_dump(s, sort_keys=False))
+        path.write_text(
+            f"# {scene_path.name} continued from {run_dir} at t = {t} s (launch.py --resume)\n"
+            + yaml.safe_dump(s, sort_keys=False)
+        )
     except OSError as e:
         die(f"{path}: cannot write the continued scene: {e.strerror}")
     print(f"launch: resuming {scene_path.name} from {run_dir} at t = {t} s ({ts['steps']} steps left)")
@@ -518,11 +564,20 @@ def run_procedure(scene, scene_path, scene_text, args):
     <run dir>/<k>-<name>/ (scripts/procedure.py)."""
     sys.path.insert(0, str(ROOT / "scripts"))
     import procedure
+
     for opt in ("record", "run_id", "beam_cmd", "solid_cmd"):
         if getattr(args, opt):
             die(f"--{opt.replace('_', '-')}: not supported for a procedure (a scene with `procedure:`)")
-    passed = ["--build-dir", args.build_dir, "--transport", args.transport, "--mpi-launcher", args.mpi_launcher,
-              "--log-level", args.log_level]
+    passed = [
+        "--build-dir",
+        args.build_dir,
+        "--transport",
+        args.transport,
+        "--mpi-launcher",
+        args.mpi_launcher,
+        "--log-level",
+        args.log_level,
+    ]
     passed += (["--ranks", str(args.ranks)] if args.ranks is not None else []) + (["--verbose"] if args.verbose else [])
     passed += ["--timeout", str(args.timeout)] if args.timeout is not None else []
     passed += ["--endpoint", args.endpoint] if args.endpoint else []
@@ -550,33 +605,54 @@ def run_procedure(scene, scene_path, scene_text, args):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="scene file (YAML)")
-    ap.add_argument("--run-dir", help="run directory (default: runs/<scene>-<time>-<token>); "
-                    "refused while another launch uses it")
+    ap.add_argument(
+        "--run-dir",
+        help="run directory (default: runs/<scene>-<time>-<token>); " "refused while another launch uses it",
+    )
     ap.add_argument("--build-dir", default=str(ROOT / "build"), help="CMake build directory")
     ap.add_argument("--ranks", type=ranks_arg, help="MPI ranks of the solid solver (overrides solid.ranks)")
-    ap.add_argument("--transport", choices=["auto", "unix", "tcp"], default="auto",
-                    help="auto: a unix socket in the run directory, tcp on this host's address when a "
-                         "Slurm allocation spans nodes (the solid's ranks may start elsewhere)")
-    ap.add_argument("--endpoint", type=endpoint_arg,
-                    help="the coupler's zenoh endpoint, e.g. tcp/10.0.0.1:7447 (default: chosen by --transport); "
-                         "for participants on other hosts or network namespaces")
-    ap.add_argument("--mpi-launcher", choices=["auto", "mpirun", "srun"], default="auto",
-                    help="how the solid's ranks start (auto: srun inside a Slurm allocation, else mpirun)")
+    ap.add_argument(
+        "--transport",
+        choices=["auto", "unix", "tcp"],
+        default="auto",
+        help="auto: a unix socket in the run directory, tcp on this host's address when a "
+        "Slurm allocation spans nodes (the solid's ranks may start elsewhere)",
+    )
+    ap.add_argument(
+        "--endpoint",
+        type=endpoint_arg,
+        help="the coupler's zenoh endpoint, e.g. tcp/10.0.0.1:7447 (default: chosen by --transport); "
+        "for participants on other hosts or network namespaces",
+    )
+    ap.add_argument(
+        "--mpi-launcher",
+        choices=["auto", "mpirun", "srun"],
+        default="auto",
+        help="how the solid's ranks start (auto: srun inside a Slurm allocation, else mpirun)",
+    )
     ap.add_argument("--record", action="store_true", help="record all exchanges (coupled scenes)")
-    ap.add_argument("--timeout", type=float,
-                    help="peer silence timeout, s (default: the executables' own, `coupler --help`)")
+    ap.add_argument(
+        "--timeout", type=float, help="peer silence timeout, s (default: the executables' own, `coupler --help`)"
+    )
     ap.add_argument("--log-level", default="info", choices=["debug", "info", "warn", "error"])
-    ap.add_argument("--verbose", action="store_true",
-                    help="show every participant's output on the terminal (default: coupler only)")
+    ap.add_argument(
+        "--verbose", action="store_true", help="show every participant's output on the terminal (default: coupler only)"
+    )
     ap.add_argument("--run-id", help="run id (default: random); replays need the recorded one")
     ap.add_argument("--beam-cmd", help="replace the beam participant executable (same CLI)")
     ap.add_argument("--solid-cmd", help="replace the solid participant executable (same CLI)")
-    ap.add_argument("--resume", metavar="RUN_DIR",
-                    help="continue a stopped run of this scene from its state files (RUN_DIR/solid/state.h5, "
-                         "beam/state.h5) to the scene's end, into RUN_DIR/continued-<time>/ unless --run-dir")
-    ap.add_argument("--check", action="store_true",
-                    help="check the scene (every executable reads its keys; a patient's geometry is generated "
-                         "and meshed) and exit 0, or 2 naming the file and key; nothing is run or written")
+    ap.add_argument(
+        "--resume",
+        metavar="RUN_DIR",
+        help="continue a stopped run of this scene from its state files (RUN_DIR/solid/state.h5, "
+        "beam/state.h5) to the scene's end, into RUN_DIR/continued-<time>/ unless --run-dir",
+    )
+    ap.add_argument(
+        "--check",
+        action="store_true",
+        help="check the scene (every executable reads its keys; a patient's geometry is generated "
+        "and meshed) and exit 0, or 2 naming the file and key; nothing is run or written",
+    )
     args = ap.parse_args()
     if args.timeout is not None and not (math.isfinite(args.timeout) and args.timeout > 0):
         die(f"--timeout: expected a positive number of seconds, got {args.timeout}")
@@ -616,7 +692,11 @@ def main():
     if has_stent:
         beam_exe = command_arg("--beam-cmd", args.beam_cmd) if args.beam_cmd else [find_binary(build, "beam_solver")]
     if has_solid:
-        solid_exe = command_arg("--solid-cmd", args.solid_cmd) if args.solid_cmd else mpirun + [find_binary(build, "solid_solver")]
+        solid_exe = (
+            command_arg("--solid-cmd", args.solid_cmd)
+            if args.solid_cmd
+            else mpirun + [find_binary(build, "solid_solver")]
+        )
     if has_stent and has_solid:
         coupler_exe = [find_binary(build, "coupler")]
 
@@ -624,9 +704,11 @@ def main():
     # exists means a bad key anywhere leaves nothing behind. Replaced commands (--beam-cmd,
     # --solid-cmd) may not know --check and are not asked.
     check_path = scene_path if prepared is None else scratch_scene(prepared)
-    checks = [("beam_solver", beam_exe if has_stent and not args.beam_cmd else None),
-              ("solid_solver", [find_binary(build, "solid_solver")] if has_solid and not args.solid_cmd else None),
-              ("coupler", coupler_exe)]
+    checks = [
+        ("beam_solver", beam_exe if has_stent and not args.beam_cmd else None),
+        ("solid_solver", [find_binary(build, "solid_solver")] if has_solid and not args.solid_cmd else None),
+        ("coupler", coupler_exe),
+    ]
     for name, exe in checks:
         if exe:
             check_scene_with(name, exe, check_path)
@@ -642,7 +724,7 @@ def main():
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = Path(args.run_dir or ROOT / "runs" / f"{scene_path.stem}-{stamp}-{token}").resolve()
     make_run_dir(run_dir, explicit=args.run_dir is not None)
-    lock = lock_run_dir(run_dir)  # the flock lasts as long as this open file, i.e. until main returns
+    lock = lock_run_dir(run_dir)  # noqa: F841 (the flock lasts as long as this open file, i.e. until main returns)
     solver_scene = scene_path
     try:
         if prepared is None:
@@ -662,8 +744,11 @@ def main():
         endpoint = args.endpoint or pick_endpoint(run_dir, args.transport)
         coupled = ["--endpoint", endpoint, "--run-id", run_id]
         coupler = coupler_exe + common + coupled + (["--record"] if args.record else [])
-        plan = [("coupler", coupler), ("beam_solver", beam_exe + common + coupled),
-                ("solid_solver", solid_exe + common + coupled)]
+        plan = [
+            ("coupler", coupler),
+            ("beam_solver", beam_exe + common + coupled),
+            ("solid_solver", solid_exe + common + coupled),
+        ]
     elif has_stent:
         plan = [("beam_solver", beam_exe + common)]
     else:
@@ -730,8 +815,11 @@ def main():
     if failed:
         name, rc = failed
         why = last_error_line(run_dir / f"{name}.log")
-        print(f"launch: error: {name} exited with code {rc} after {wall:.1f} s{': ' + why if why else ''} "
-              f"(log: {run_dir / (name + '.log')}); the other processes were stopped", file=sys.stderr)
+        print(
+            f"launch: error: {name} exited with code {rc} after {wall:.1f} s{': ' + why if why else ''} "
+            f"(log: {run_dir / (name + '.log')}); the other processes were stopped",
+            file=sys.stderr,
+        )
         # 2 is every executable's "bad scene or mesh" (the message names the file and key): passed on
         # unchanged, so that a bad scene is exit code 2 from the launcher as from the solvers
         return 2 if rc == 2 else 10 + [n for n, _ in plan].index(name)

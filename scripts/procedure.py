@@ -59,15 +59,18 @@ def phases(scene, path):
     if not isinstance(proc, list) or not proc:
         raise ProcedureError(f"{path}: procedure: expected a non-empty list of phases, got {proc!r:.60}")
     if "artery" not in scene:
-        raise ProcedureError(f"{path}: procedure: expected an `artery:` section (the procedure carries the artery "
-                             "from phase to phase), got none")
+        raise ProcedureError(
+            f"{path}: procedure: expected an `artery:` section (the procedure carries the artery "
+            "from phase to phase), got none"
+        )
     t = scene.get("time") or {}
     if not isinstance(t, dict):
         raise ProcedureError(f"{path}: time: expected a map, got {t!r:.60}")
     for k in ("end", "steps"):
         if k in t:
-            raise ProcedureError(f"{path}: time.{k}: expected it per phase (procedure[k].{k}) in a procedure, "
-                                 "got it in `time:`")
+            raise ProcedureError(
+                f"{path}: time.{k}: expected it per phase (procedure[k].{k}) in a procedure, " "got it in `time:`"
+            )
     start = t.get("start", 0.0)
     if not _number(start):
         raise ProcedureError(f"{path}: time.start: expected a number, got {start!r:.60}")
@@ -87,12 +90,15 @@ def phases(scene, path):
         names.add(name)
         end = ph.get("end")
         if not _number(end) or not end > start:
-            raise ProcedureError(f"{path}: {key}.end: expected a time after the phase's start {start} s (phases "
-                                 f"follow each other without overlap or gap), got {end!r:.60}")
+            raise ProcedureError(
+                f"{path}: {key}.end: expected a time after the phase's start {start} s (phases "
+                f"follow each other without overlap or gap), got {end!r:.60}"
+            )
         steps = ph.get("steps")
         if not isinstance(steps, int) or isinstance(steps, bool) or not 1 <= steps <= 100000:
-            raise ProcedureError(f"{path}: {key}.steps: expected a number of load steps from 1 to 100000, "
-                                 f"got {steps!r:.60}")
+            raise ProcedureError(
+                f"{path}: {key}.steps: expected a number of load steps from 1 to 100000, " f"got {steps!r:.60}"
+            )
         stent = ph.get("stent", stent_on)
         if not isinstance(stent, bool):
             raise ProcedureError(f"{path}: {key}.stent: expected true or false, got {stent!r:.60}")
@@ -107,10 +113,13 @@ def phases(scene, path):
         half = 0.5 * float(scene["artery"]["mesh"].get("length", 0.0)) if ext else 0.0
         if ext and (ext[0] < -half - 1e-9 or ext[1] > half + 1e-9):
             where = f"{key}.balloon.mesh" if "balloon" in ph else "balloon.mesh"
-            raise ProcedureError(f"{path}: {where}: expected a balloon within the artery (axially {-half:g} to {half:g} mm "
-                                 f"from its centre), got {ext[0]:g} to {ext[1]:g} mm")
-        out.append({"name": name, "start": float(start), "end": float(end), "steps": steps, "balloon": balloon,
-                    "stent": stent})
+            raise ProcedureError(
+                f"{path}: {where}: expected a balloon within the artery (axially {-half:g} to {half:g} mm "
+                f"from its centre), got {ext[0]:g} to {ext[1]:g} mm"
+            )
+        out.append(
+            {"name": name, "start": float(start), "end": float(end), "steps": steps, "balloon": balloon, "stent": stent}
+        )
         start, stent_on = end, stent
     return out
 
@@ -128,9 +137,11 @@ def complete(scene, path, out_dir, log=print):
     from patient.centerline_csv import arc_length
     from patient.errors import PatientInputError
     from patient.prepare import prepare_scene
+
     try:
-        done, _ = prepare_scene({k: v for k, v in scene.items() if k != "procedure"}, path, out_dir,
-                                log=lambda m: log(f"procedure: {m}"))
+        done, _ = prepare_scene(
+            {k: v for k, v in scene.items() if k != "procedure"}, path, out_dir, log=lambda m: log(f"procedure: {m}")
+        )
     except PatientInputError as e:
         raise ProcedureError(str(e))
     done["procedure"] = copy.deepcopy(scene["procedure"])
@@ -144,15 +155,19 @@ def complete(scene, path, out_dir, log=print):
         key = f"procedure[{k}].balloon.mesh"
         for x in ("center", "centerline", "start", "file"):
             if x in m:
-                raise ProcedureError(f"{path}: {key}.{x}: expected none with a `patient:` section (the phase's balloon "
-                                     "is placed on the device centerline at the stenosis)")
+                raise ProcedureError(
+                    f"{path}: {key}.{x}: expected none with a `patient:` section (the phase's balloon "
+                    "is placed on the device centerline at the stenosis)"
+                )
         L = m.get("length")
         if not _number(L) or L <= 0:
             raise ProcedureError(f"{path}: {key}.length: expected a positive length (mm), got {L!r:.60}")
         start = centre - 0.5 * L
         if start < -1e-9 or start + L > length + 1e-9:
-            raise ProcedureError(f"{path}: {key}.length: expected a balloon that fits on the device centerline "
-                                 f"({length:.2f} mm) centred on the scene's balloon at {centre:.2f} mm, got {L} mm")
+            raise ProcedureError(
+                f"{path}: {key}.length: expected a balloon that fits on the device centerline "
+                f"({length:.2f} mm) centred on the scene's balloon at {centre:.2f} mm, got {L} mm"
+            )
         m["centerline"] = copy.deepcopy(base["centerline"])
         m["start"] = round(max(start, 0.0), 9)
     return done
@@ -174,8 +189,10 @@ def phase_scene(scene, phase, previous=None):
                 s["contact"].pop(c, None)
     if previous is not None:
         prev_dir, prev_stent = previous
-        s.setdefault("solid", {})["initial_state"] = {"file": str(Path(prev_dir) / "solid" / "state.h5"),
-                                                      "parts": ["artery"]}
+        s.setdefault("solid", {})["initial_state"] = {
+            "file": str(Path(prev_dir) / "solid" / "state.h5"),
+            "parts": ["artery"],
+        }
         if prev_stent:
             s["stent"]["initial_state"] = {"file": str(Path(prev_dir) / "beam" / "state.h5")}
     return s
@@ -197,14 +214,16 @@ def check(scene, path, launch_args):
         for k, ph in enumerate(phases(scene, path)):
             p = Path(tmp) / f"{k + 1}-{ph['name']}.yaml"
             _write(p, phase_scene(scene, ph), f"phase {k + 1} of {path}, as checked")
-            r = subprocess.run([sys.executable, str(LAUNCH), str(p), "--check"] + launch_args,
-                               capture_output=True, text=True)
+            r = subprocess.run(
+                [sys.executable, str(LAUNCH), str(p), "--check"] + launch_args, capture_output=True, text=True
+            )
             if r.returncode != 0:
                 msg = (r.stderr.strip() or r.stdout.strip()).splitlines()
                 raise ProcedureError(f"{path}: procedure[{k}] ({ph['name']}): {msg[-1] if msg else 'check failed'}")
 
 
 # --- results per phase -------------------------------------------------------------------------
+
 
 def _load(p):
     try:
@@ -277,16 +296,22 @@ def phase_results(pdir, phase, before, stations, mask):
     d_peak, d_end = _lumen_min(peak, mask), _lumen_min(last, mask)
     out["lumen"] = {
         "min_diameter_before_procedure": d0,
-        "min_diameter_at_peak": d_peak, "min_diameter_end": d_end,
+        "min_diameter_at_peak": d_peak,
+        "min_diameter_end": d_end,
         "min_area_end": _area(d_end),
         "gain_since_procedure_start": d_end - d0 if _number(d_end) and _number(d0) else None,
         "acute_recoil": (d_peak - d_end) / d_peak if _number(d_peak) and _number(d_end) and d_peak > 0 else None,
-        "peak_time": peak.get("time"), "peak_balloon_pressure": peak.get("balloon_pressure"),
+        "peak_time": peak.get("time"),
+        "peak_balloon_pressure": peak.get("balloon_pressure"),
     }
-    out["stress"] = {"at_peak": peak.get("max_principal_stress"), "end": last.get("max_principal_stress"),
-                     "p99_at_peak": peak.get("p99_principal_stress"), "p99_end": last.get("p99_principal_stress"),
-                     "endothelium_nodal_at_peak": peak.get("max_principal_stress_endothelium_nodal"),
-                     "endothelium_nodal_end": last.get("max_principal_stress_endothelium_nodal")}
+    out["stress"] = {
+        "at_peak": peak.get("max_principal_stress"),
+        "end": last.get("max_principal_stress"),
+        "p99_at_peak": peak.get("p99_principal_stress"),
+        "p99_end": last.get("p99_principal_stress"),
+        "endothelium_nodal_at_peak": peak.get("max_principal_stress_endothelium_nodal"),
+        "endothelium_nodal_end": last.get("max_principal_stress_endothelium_nodal"),
+    }
     # with the stent: the minimal lumen area inside it (stations within its extent) against the
     # reference lumen area, IVUS' stent expansion (minimal stent area / reference lumen area; the
     # lumen inside the stent is the stent's area where the struts are apposed)
@@ -295,9 +320,12 @@ def phase_results(pdir, phase, before, stations, mask):
         in_stent = [ext[0] <= z <= ext[1] for z in stations]
         d_in = _lumen_min(last, in_stent) if any(in_stent) else None
         ref = reference_area(before, mask)
-        out["in_stent"] = {"min_lumen_diameter_end": d_in, "min_lumen_area_end": _area(d_in),
-                           "reference_lumen_area": ref,
-                           "expansion": _area(d_in) / ref if _number(d_in) and ref else None}
+        out["in_stent"] = {
+            "min_lumen_diameter_end": d_in,
+            "min_lumen_area_end": _area(d_in),
+            "reference_lumen_area": ref,
+            "expansion": _area(d_in) / ref if _number(d_in) and ref else None,
+        }
     if last.get("apposition"):
         out["apposition_end"] = last["apposition"]
     out["artery_contact_force_end"] = last.get("artery_contact_force")
@@ -323,18 +351,27 @@ def summarize(run_dir, scene, path, ran):
         if (s.get("balloon_pressure") or 0.0) > 0.0:
             break
         before = s
-    out = {"scene": str(path), "units": {"length": "mm", "area": "mm^2", "stress": "MPa", "time": "s"},
-           "lumen_before_procedure": {"time": before.get("time"), "profile": before.get("lumen_diameter"),
-                                      "stations": stations},
-           "phases": []}
+    out = {
+        "scene": str(path),
+        "units": {"length": "mm", "area": "mm^2", "stress": "MPa", "time": "s"},
+        "lumen_before_procedure": {
+            "time": before.get("time"),
+            "profile": before.get("lumen_diameter"),
+            "stations": stations,
+        },
+        "phases": [],
+    }
     stent_ext = None
     for k, ph, _, _ in ran:
         if ph["stent"]:
             last = ((_load(phase_dir(run_dir, k, ph) / "solid" / "summary.json") or {}).get("steps") or [{}])[-1]
             stent_ext = last.get("stent_stations") or stent_ext
     mask = treated_segment(scene, [ph for _, ph, _, _ in ran], stations, stent_ext)
-    out["segment"] = ("stations covered by the procedure's devices (balloons and stent)" if mask
-                      else "all stations (a device extent is not known)")
+    out["segment"] = (
+        "stations covered by the procedure's devices (balloons and stent)"
+        if mask
+        else "all stations (a device extent is not known)"
+    )
     for k, ph, status, wall in ran:
         r = phase_results(phase_dir(run_dir, k, ph), ph, before, stations, mask)
         r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
@@ -342,8 +379,10 @@ def summarize(run_dir, scene, path, ran):
     (run_dir / "procedure.json").write_text(json.dumps(out, indent=1) + "\n")
     try:
         import matplotlib
+
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+
         if stations and before.get("lumen_diameter"):
             fig, ax = plt.subplots(figsize=(7, 4))
             ax.plot(stations, before["lumen_diameter"], "k--", label="before the procedure")
@@ -372,8 +411,11 @@ def run(scene, path, run_dir, launch_args):
         pdir = phase_dir(run_dir, k, phase)
         scene_file = run_dir / f"{k + 1}-{phase['name']}.yaml"
         _write(scene_file, phase_scene(scene, phase, previous), f"phase {k + 1} ({phase['name']}) of {path}")
-        print(f"procedure: phase {k + 1}/{len(ph)} {phase['name']}: t = {phase['start']} .. {phase['end']} s, "
-              f"{phase['steps']} steps{', stent' if phase['stent'] else ''}", flush=True)
+        print(
+            f"procedure: phase {k + 1}/{len(ph)} {phase['name']}: t = {phase['start']} .. {phase['end']} s, "
+            f"{phase['steps']} steps{', stent' if phase['stent'] else ''}",
+            flush=True,
+        )
         t0 = clock.time()
         rc = subprocess.call([sys.executable, str(LAUNCH), str(scene_file), "--run-dir", str(pdir)] + launch_args)
         ran.append((k, phase, "ok" if rc == 0 else f"failed (exit {rc})", clock.time() - t0))
@@ -386,8 +428,10 @@ def run(scene, path, run_dir, launch_args):
     for r in out["phases"]:
         lum = r.get("lumen") or {}
         fmt = lambda v: f"{v:.3f}" if _number(v) else "-"  # noqa: E731
-        print(f"procedure: {r['name']:16s} {r['status']:10s} min lumen {fmt(lum.get('min_diameter_at_peak'))} mm at "
-              f"peak, {fmt(lum.get('min_diameter_end'))} mm at end (gain {fmt(lum.get('gain_since_procedure_start'))} "
-              f"mm, recoil {fmt(lum.get('acute_recoil'))}), {r['wall_seconds']} s")
+        print(
+            f"procedure: {r['name']:16s} {r['status']:10s} min lumen {fmt(lum.get('min_diameter_at_peak'))} mm at "
+            f"peak, {fmt(lum.get('min_diameter_end'))} mm at end (gain {fmt(lum.get('gain_since_procedure_start'))} "
+            f"mm, recoil {fmt(lum.get('acute_recoil'))}), {r['wall_seconds']} s"
+        )
     print(f"procedure: {run_dir / 'procedure.json'}")
     return code

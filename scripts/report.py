@@ -46,27 +46,46 @@ except ImportError:
 # for e.g. diamond-shaped stents" (its ref. [90]), i.e. the stent's dogboning: we compare it with
 # the stent's (D_distal - D_central)/D_distal, the definition of that literature; the balloon's own
 # bulge at the stent ends is reported without a paper value.
-PAPER = {"diameter_initial": 1.15, "diameter_max": 2.59, "diameter_final": 2.31,
-         "recoil": 0.28, "recoil_percent": 10.8, "dogboning_percent": 20.4, "dogboning_atm": 10.4}
+PAPER = {
+    "diameter_initial": 1.15,
+    "diameter_max": 2.59,
+    "diameter_final": 2.31,
+    "recoil": 0.28,
+    "recoil_percent": 10.8,
+    "dogboning_percent": 20.4,
+    "dogboning_atm": 10.4,
+}
 # Paper §4.1 (stent in the generic artery, Figs. 8-10), used for scenes with a stent and an artery.
 # Stent diameter at 13 atm and after deflation (the recoil in mm is their difference); the
 # prestressed state (85 mmHg): max artery displacement and max first principal Cauchy stress per
 # layer; at 13 atm ("peak") the 7.99 MPa is at the endothelium, i.e. the innermost layer (key
 # "innermost"); after deflation per layer. Stresses in MPa.
-PAPER_ARTERY = {"diameter_initial": 1.15, "diameter_peak": 2.12, "diameter_final": 1.89,
-                "recoil": 0.23, "recoil_percent": 10.8, "prestressed_max_displacement": 0.14,
-                "stress": {"prestressed": {"media": 0.0023, "adventitia": 0.00017},
-                           "peak": {"innermost": 7.99, "adventitia": 0.0495},
-                           "after": {"media": 0.1875, "adventitia": 0.0137}}}
+PAPER_ARTERY = {
+    "diameter_initial": 1.15,
+    "diameter_peak": 2.12,
+    "diameter_final": 1.89,
+    "recoil": 0.23,
+    "recoil_percent": 10.8,
+    "prestressed_max_displacement": 0.14,
+    "stress": {
+        "prestressed": {"media": 0.0023, "adventitia": 0.00017},
+        "peak": {"innermost": 7.99, "adventitia": 0.0495},
+        "after": {"media": 0.1875, "adventitia": 0.0137},
+    },
+}
 # Paper §4.2.3 (its patient's right coronary artery, Fig. 12), for patient scenes (a run directory
 # with geometry/placement.json): max first principal Cauchy stress per layer, the intima being the
 # innermost layer (endothelium); the prestressed media/adventitia values are not stated. A patient
 # of our own (configs/patient_like.yaml) is a different artery: the column gives the magnitudes.
-PAPER_PATIENT = {"stress": {"prestressed": {"innermost": 0.0481},
-                            "peak": {"innermost": 0.757, "media": 0.0783, "adventitia": 0.1359},
-                            "after": {"innermost": 0.1914, "media": 0.0489, "adventitia": 0.0495}}}
+PAPER_PATIENT = {
+    "stress": {
+        "prestressed": {"innermost": 0.0481},
+        "peak": {"innermost": 0.757, "media": 0.0783, "adventitia": 0.1359},
+        "after": {"innermost": 0.1914, "media": 0.0489, "adventitia": 0.0495},
+    }
+}
 ATM = 0.101325  # MPa
-KPA = 1000.0    # kPa per MPa
+KPA = 1000.0  # kPa per MPa
 PHASES = ("prestressed", "peak", "after")
 
 
@@ -183,8 +202,11 @@ def plot_lines(path, series, xlabel, ylabel, logy=False, span=None):
 def artery_layers(solid, scene):
     """Artery layer (block) names, inside out: the solid blocks whose part is "artery", ordered as
     the scene's artery.mesh.layers list them (a generated tube lists them from the lumen out)."""
-    names = [b.get("name") for b in (get(solid, "blocks") or [])
-             if isinstance(b, dict) and b.get("part") == "artery" and isinstance(b.get("name"), str)]
+    names = [
+        b.get("name")
+        for b in (get(solid, "blocks") or [])
+        if isinstance(b, dict) and b.get("part") == "artery" and isinstance(b.get("name"), str)
+    ]
     listed = [l.get("name") for l in (get(scene, "artery", "mesh", "layers") or []) if isinstance(l, dict)]
     return [n for n in listed if n in names] + [n for n in names if n not in listed]
 
@@ -219,17 +241,24 @@ def read_apposition_csv(path):
         t, thr = f(m_t.group(1) if m_t else None), f(m_thr.group(1) if m_thr else None)
     except ValueError:
         t = thr = None
-    return {"time": t, "threshold": thr, "points": n, "malapposed_points": nmal, "stent_length": length,
-            "malapposed_length": mal_len, "malapposed_fraction": mal_len / length if length > 0 else None,
-            "max_gap": max(gaps) if gaps else None, "min_gap": min(gaps) if gaps else None}
+    return {
+        "time": t,
+        "threshold": thr,
+        "points": n,
+        "malapposed_points": nmal,
+        "stent_length": length,
+        "malapposed_length": mal_len,
+        "malapposed_fraction": mal_len / length if length > 0 else None,
+        "max_gap": max(gaps) if gaps else None,
+        "min_gap": min(gaps) if gaps else None,
+    }
 
 
 def artery_report(run, scene, solid, beam, with_paper):
     """Table rows (stent rows, artery rows), the results.json "artery" section and the plot data of an
     artery scene."""
     rows, stent_rows = [], []
-    P = ((PAPER_PATIENT if (run / "geometry" / "placement.json").is_file() else PAPER_ARTERY)
-         if with_paper else {})
+    P = (PAPER_PATIENT if (run / "geometry" / "placement.json").is_file() else PAPER_ARTERY) if with_paper else {}
     pstress = P.get("stress", {})
     steps = [s for s in (get(solid, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
     beam_steps = [s for s in (get(beam, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
@@ -260,12 +289,18 @@ def artery_report(run, scene, solid, beam, with_paper):
         if ph[k] is not None:
             times[k] = ph[k]["time"]
 
-    section = {"units": {"length": "mm", "stress": "MPa", "force": "N", "pressure": "MPa", "time": "s"},
-               "layers": layers, "innermost_layer": innermost,
-               "paper": P or None,
-               "phase_definitions": {"prestressed": "last step with t <= 0 (before the balloon pressure rises)",
-                                     "peak": peak_source, "after": "last step"},
-               "phases": {}}
+    section = {
+        "units": {"length": "mm", "stress": "MPa", "force": "N", "pressure": "MPa", "time": "s"},
+        "layers": layers,
+        "innermost_layer": innermost,
+        "paper": P or None,
+        "phase_definitions": {
+            "prestressed": "last step with t <= 0 (before the balloon pressure rises)",
+            "peak": peak_source,
+            "after": "last step",
+        },
+        "phases": {},
+    }
     phase_out = section["phases"]
     for k in PHASES:
         s = ph[k]
@@ -283,18 +318,20 @@ def artery_report(run, scene, solid, beam, with_paper):
                 paper = pstress.get(k, {}).get("innermost")
             at = get(s, "max_principal_stress_at", L)
             at_n = get(s, "max_principal_stress_nodal_at", L)
-            e["layers"][L] = {"max_principal_stress": num(get(s, "max_principal_stress", L)),
-                              "p99_principal_stress": num(get(s, "p99_principal_stress", L)),
-                              "max_principal_stress_at": at if isinstance(at, list) else None,
-                              "max_principal_stress_nodal": num(get(s, "max_principal_stress_nodal", L)),
-                              "p99_principal_stress_nodal": num(get(s, "p99_principal_stress_nodal", L)),
-                              "max_principal_stress_nodal_at": at_n if isinstance(at_n, list) else None,
-                              "max_principal_stress_endothelium_nodal":
-                                  num(get(s, "max_principal_stress_endothelium_nodal", L)),
-                              "paper_max_principal_stress": paper,
-                              # the paper's peak "at the endothelial surface" (§4.1): the innermost layer's
-                              "paper_max_principal_stress_endothelium":
-                                  pstress.get(k, {}).get("innermost") if L == innermost else None}
+            e["layers"][L] = {
+                "max_principal_stress": num(get(s, "max_principal_stress", L)),
+                "p99_principal_stress": num(get(s, "p99_principal_stress", L)),
+                "max_principal_stress_at": at if isinstance(at, list) else None,
+                "max_principal_stress_nodal": num(get(s, "max_principal_stress_nodal", L)),
+                "p99_principal_stress_nodal": num(get(s, "p99_principal_stress_nodal", L)),
+                "max_principal_stress_nodal_at": at_n if isinstance(at_n, list) else None,
+                "max_principal_stress_endothelium_nodal": num(get(s, "max_principal_stress_endothelium_nodal", L)),
+                "paper_max_principal_stress": paper,
+                # the paper's peak "at the endothelial surface" (§4.1): the innermost layer's
+                "paper_max_principal_stress_endothelium": pstress.get(k, {}).get("innermost")
+                if L == innermost
+                else None,
+            }
         e["artery_contact_force"] = {n: num(f) for n, f in (get(s, "artery_contact_force") or {}).items()}
         e["apposition"] = get(s, "apposition") if isinstance(get(s, "apposition"), dict) else None
         e["lumen_diameter_min_all_stations"] = num(get(s, "lumen_diameter_min"))
@@ -306,8 +343,10 @@ def artery_report(run, scene, solid, beam, with_paper):
     phase_out["after"]["deflated"] = deflated
     section["notes"] = []
     if deflated is False:
-        section["notes"].append(f"the run ended at t = {times['after']:g} s with the balloon at {after_bp / ATM:.3g} "
-                                "atm: the 'after' values are not after deflation")
+        section["notes"].append(
+            f"the run ended at t = {times['after']:g} s with the balloon at {after_bp / ATM:.3g} "
+            "atm: the 'after' values are not after deflation"
+        )
 
     f3 = lambda v: "-" if v is None else f"{v:g}"  # noqa: E731
     if any(t is not None for t in times.values()):
@@ -323,17 +362,26 @@ def artery_report(run, scene, solid, beam, with_paper):
         D_final = num(d.get("final"))
     recoil = D_peak - D_final if D_peak is not None and D_final is not None else None
     recoil_pct = 100 * recoil / D_peak if recoil is not None and D_peak else None
-    section["stent"] = {"diameter_initial": num(d.get("initial")), "diameter_max": num(d.get("max")),
-                        "time_of_max": num(d.get("time_of_max")), "diameter_peak": D_peak, "time_peak": times["peak"],
-                        "diameter_final": D_final, "recoil": recoil, "recoil_percent": recoil_pct,
-                        "recoil_definition": "peak-pressure diameter minus final diameter (percent of the peak one)"}
+    section["stent"] = {
+        "diameter_initial": num(d.get("initial")),
+        "diameter_max": num(d.get("max")),
+        "time_of_max": num(d.get("time_of_max")),
+        "diameter_peak": D_peak,
+        "time_peak": times["peak"],
+        "diameter_final": D_final,
+        "recoil": recoil,
+        "recoil_percent": recoil_pct,
+        "recoil_definition": "peak-pressure diameter minus final diameter (percent of the peak one)",
+    }
     if beam:
-        stent_rows += [("stent diameter crimped (mm)", num(d.get("initial")), P.get("diameter_initial")),
-                       ("stent diameter max (mm)", num(d.get("max")), None),
-                       ("stent diameter at peak pressure (mm)", D_peak, P.get("diameter_peak")),
-                       ("stent diameter final (mm)", D_final, P.get("diameter_final")),
-                       ("elastic recoil, peak - final (mm)", recoil, P.get("recoil")),
-                       ("elastic recoil, peak - final (%)", recoil_pct, P.get("recoil_percent"))]
+        stent_rows += [
+            ("stent diameter crimped (mm)", num(d.get("initial")), P.get("diameter_initial")),
+            ("stent diameter max (mm)", num(d.get("max")), None),
+            ("stent diameter at peak pressure (mm)", D_peak, P.get("diameter_peak")),
+            ("stent diameter final (mm)", D_final, P.get("diameter_final")),
+            ("elastic recoil, peak - final (mm)", recoil, P.get("recoil")),
+            ("elastic recoil, peak - final (%)", recoil_pct, P.get("recoil_percent")),
+        ]
 
     # artery displacement and stresses per phase and layer (table in kPa)
     u_pre = num(get(phase_out, "prestressed", "max_displacement", "artery"))
@@ -345,21 +393,36 @@ def artery_report(run, scene, solid, beam, with_paper):
         for L in layers:
             e = phase_out[k]["layers"][L]
             if e["max_principal_stress"] is not None:
-                rows.append((f"{k}: {L} max principal stress (kPa)", e["max_principal_stress"] * KPA,
-                             scaled(e["paper_max_principal_stress"], KPA)))
+                rows.append(
+                    (
+                        f"{k}: {L} max principal stress (kPa)",
+                        e["max_principal_stress"] * KPA,
+                        scaled(e["paper_max_principal_stress"], KPA),
+                    )
+                )
             if k != "prestressed" and e["p99_principal_stress"] is not None:
                 rows.append((f"{k}: {L} p99 principal stress (kPa)", e["p99_principal_stress"] * KPA, None))
             # recovered nodal values (solid/summary.json *_nodal; absent in older runs: no rows)
             if e["max_principal_stress_nodal"] is not None:
-                rows.append((f"{k}: {L} max principal stress, nodal (kPa)", e["max_principal_stress_nodal"] * KPA,
-                             scaled(e["paper_max_principal_stress"], KPA)))
+                rows.append(
+                    (
+                        f"{k}: {L} max principal stress, nodal (kPa)",
+                        e["max_principal_stress_nodal"] * KPA,
+                        scaled(e["paper_max_principal_stress"], KPA),
+                    )
+                )
             if e["max_principal_stress_endothelium_nodal"] is not None:
-                rows.append((f"{k}: {L} max principal stress, endothelium nodal (kPa)",
-                             e["max_principal_stress_endothelium_nodal"] * KPA,
-                             scaled(e["paper_max_principal_stress_endothelium"], KPA)))
+                rows.append(
+                    (
+                        f"{k}: {L} max principal stress, endothelium nodal (kPa)",
+                        e["max_principal_stress_endothelium_nodal"] * KPA,
+                        scaled(e["paper_max_principal_stress_endothelium"], KPA),
+                    )
+                )
             if k != "prestressed" and e["p99_principal_stress_nodal"] is not None:
-                rows.append((f"{k}: {L} p99 principal stress, nodal (kPa)", e["p99_principal_stress_nodal"] * KPA,
-                             None))
+                rows.append(
+                    (f"{k}: {L} p99 principal stress, nodal (kPa)", e["p99_principal_stress_nodal"] * KPA, None)
+                )
 
     # lumen
     stations = [num(v) for v in (get(solid, "lumen_stations") or [])]
@@ -371,10 +434,14 @@ def artery_report(run, scene, solid, beam, with_paper):
     ext = get(ph["after"], "stent_stations")
     ext = (num(ext[0]), num(ext[1])) if isinstance(ext, list) and len(ext) == 2 else None
     ext = ext if ext and None not in ext else None
-    how = ("solid/summary.json stent_stations of the last step (the beam sample points on the lumen stations)"
-           if ext else "not determined: no stent_stations in solid/summary.json")
-    lumen["stent_extent"] = {"min": ext[0], "max": ext[1], "source": how} if ext else {"min": None, "max": None,
-                                                                                       "source": how}
+    how = (
+        "solid/summary.json stent_stations of the last step (the beam sample points on the lumen stations)"
+        if ext
+        else "not determined: no stent_stations in solid/summary.json"
+    )
+    lumen["stent_extent"] = (
+        {"min": ext[0], "max": ext[1], "source": how} if ext else {"min": None, "max": None, "source": how}
+    )
     n_st = len(stations)
     mask = [ext is not None and s is not None and ext[0] <= s <= ext[1] for s in stations]
     if any(mask):
@@ -398,9 +465,11 @@ def artery_report(run, scene, solid, beam, with_paper):
     else:
         lumen["gain_per_station"], lumen["gain_mean"] = None, None
     lumen["gain_definition"] = "lumen diameter after minus prestressed, mean over the scope's stations"
-    lumen["min_lumen_diameter_gain"] = (lumen["min"]["after"] - lumen["min"]["prestressed"]
-                                        if lumen["min"].get("after") is not None
-                                        and lumen["min"].get("prestressed") is not None else None)
+    lumen["min_lumen_diameter_gain"] = (
+        lumen["min"]["after"] - lumen["min"]["prestressed"]
+        if lumen["min"].get("after") is not None and lumen["min"].get("prestressed") is not None
+        else None
+    )
     section["lumen"] = lumen
     where = "stented" if scope == "stented" else "all stations"
     for k in PHASES:
@@ -413,8 +482,11 @@ def artery_report(run, scene, solid, beam, with_paper):
     thr = num(get(solid, "apposition_threshold"))
     app = phase_out["after"]["apposition"]
     app_csv = read_apposition_csv(run / "solid" / "apposition.csv")
-    ap = {"threshold": thr, "time": times["after"] if app else None,
-          "source": "solid/summary.json, last step" if app else None}
+    ap = {
+        "threshold": thr,
+        "time": times["after"] if app else None,
+        "source": "solid/summary.json, last step" if app else None,
+    }
     for key in ("stent_length", "malapposed_length", "malapposed_fraction", "max_gap", "mean_gap"):
         ap[key] = num(get(app, key))
     ap["malapposed_percent"] = scaled(ap.get("malapposed_fraction"), 100.0)
@@ -440,10 +512,12 @@ def artery_report(run, scene, solid, beam, with_paper):
     t_loaded = [s["time"] for s in loaded]
     stress_series = []
     for i, L in enumerate(layers):
-        stress_series.append((f"{L} max", t_loaded, [scaled(get(s, "max_principal_stress", L), KPA) for s in loaded],
-                              "o-", f"C{i}"))
-        stress_series.append((f"{L} p99", t_loaded, [scaled(get(s, "p99_principal_stress", L), KPA) for s in loaded],
-                              "--", f"C{i}"))
+        stress_series.append(
+            (f"{L} max", t_loaded, [scaled(get(s, "max_principal_stress", L), KPA) for s in loaded], "o-", f"C{i}")
+        )
+        stress_series.append(
+            (f"{L} p99", t_loaded, [scaled(get(s, "p99_principal_stress", L), KPA) for s in loaded], "--", f"C{i}")
+        )
         nodal = [scaled(get(s, "max_principal_stress_nodal", L), KPA) for s in loaded]
         if any(v is not None for v in nodal):
             stress_series.append((f"{L} max nodal", t_loaded, nodal, ":", f"C{i}"))
@@ -455,22 +529,37 @@ def artery_report(run, scene, solid, beam, with_paper):
             lumen_series.append((f"{k} (t = {f3(times[k])} s)", x, prof, "o-", f"C{i}"))
     names = []
     for s in steps:
-        for n in (get(s, "artery_contact_force") or {}):
+        for n in get(s, "artery_contact_force") or {}:
             if n not in names:
                 names.append(n)
-    force_series = [(f"{n} -> artery", t, [num(get(s, "artery_contact_force", n)) for s in steps], "o-", f"C{i}")
-                    for i, n in enumerate(names)]
+    force_series = [
+        (f"{n} -> artery", t, [num(get(s, "artery_contact_force", n)) for s in steps], "o-", f"C{i}")
+        for i, n in enumerate(names)
+    ]
     x_is_station = n_st > 0 and all(v is not None for v in stations)
-    plots = {"stress": stress_series, "lumen": lumen_series, "force": force_series,
-             "span": ext if (ext and x_is_station) else None, "lumen_x": "station" if x_is_station else "index"}
+    plots = {
+        "stress": stress_series,
+        "lumen": lumen_series,
+        "force": force_series,
+        "span": ext if (ext and x_is_station) else None,
+        "lumen_x": "station" if x_is_station else "index",
+    }
     straight = artery_straightening(run, times)
     if straight:
         section["straightening"] = straight
         labels = ["reference"] + [k for k in PHASES if k in straight]
-        rows += [(f"artery axis sagitta {' / '.join(labels)} (mm)",
-                  " / ".join(f"{straight[k]['sagitta']:.3f}" for k in labels), None),
-                 (f"artery axis radius {' / '.join(labels)} (mm)",
-                  " / ".join(f"{straight[k]['radius']:.1f}" for k in labels), None)]
+        rows += [
+            (
+                f"artery axis sagitta {' / '.join(labels)} (mm)",
+                " / ".join(f"{straight[k]['sagitta']:.3f}" for k in labels),
+                None,
+            ),
+            (
+                f"artery axis radius {' / '.join(labels)} (mm)",
+                " / ".join(f"{straight[k]['radius']:.1f}" for k in labels),
+                None,
+            ),
+        ]
     return (stent_rows, rows), section, plots
 
 
@@ -481,6 +570,7 @@ def artery_straightening(run, times):
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     try:
         from patient.straightening import artery_axis_bow
+
         return artery_axis_bow(run, times)
     except ImportError:  # h5py or numpy missing: the table goes without it
         return None
@@ -528,11 +618,13 @@ def main(run_dir):
     if beam and not has_artery:
         d = beam.get("diameter") if isinstance(beam.get("diameter"), dict) else {}
         out["stent"] = d
-        rows += [("stent diameter crimped (mm)", d.get("initial"), PAPER["diameter_initial"]),
-                 ("stent diameter max (mm)", d.get("max"), PAPER["diameter_max"]),
-                 ("stent diameter final (mm)", d.get("final"), PAPER["diameter_final"]),
-                 ("elastic recoil (mm)", d.get("recoil"), PAPER["recoil"]),
-                 ("elastic recoil (%)", d.get("recoil_percent"), PAPER["recoil_percent"])]
+        rows += [
+            ("stent diameter crimped (mm)", d.get("initial"), PAPER["diameter_initial"]),
+            ("stent diameter max (mm)", d.get("max"), PAPER["diameter_max"]),
+            ("stent diameter final (mm)", d.get("final"), PAPER["diameter_final"]),
+            ("elastic recoil (mm)", d.get("recoil"), PAPER["recoil"]),
+            ("elastic recoil (%)", d.get("recoil_percent"), PAPER["recoil_percent"]),
+        ]
     elif beam:
         out["stent"] = beam.get("diameter") if isinstance(beam.get("diameter"), dict) else {}
     artery = artery_report(run, scene, solid, beam, artery_with_stent) if has_artery and (solid or beam) else None
@@ -544,35 +636,63 @@ def main(run_dir):
             out["stent"].update(st)
             tdb = num(st.get("time_of_dogboning_max"))
             free = not has_artery and st.get("axis_radius_initial") is None  # the straight free expansion
-            rows += [("stent dogboning max (%)", st.get("dogboning_max_percent"),
-                      PAPER["dogboning_percent"] if free else None),
-                     ("  at time (s)", st.get("time_of_dogboning_max"), None),
-                     ("  at pressure (atm)", p_of_t.get(key_t(tdb), "-"), PAPER["dogboning_atm"] if free else None),
-                     ("foreshortening at max diameter (%)", st.get("foreshortening_at_max_diameter_percent"), None),
-                     ("foreshortening final (%)", st.get("foreshortening_final_percent"), None)]
+            rows += [
+                (
+                    "stent dogboning max (%)",
+                    st.get("dogboning_max_percent"),
+                    PAPER["dogboning_percent"] if free else None,
+                ),
+                ("  at time (s)", st.get("time_of_dogboning_max"), None),
+                ("  at pressure (atm)", p_of_t.get(key_t(tdb), "-"), PAPER["dogboning_atm"] if free else None),
+                ("foreshortening at max diameter (%)", st.get("foreshortening_at_max_diameter_percent"), None),
+                ("foreshortening final (%)", st.get("foreshortening_final_percent"), None),
+            ]
             if st.get("axis_radius_initial") is not None:  # curved device: straightening (paper §3.2)
-                rows += [("axis sagitta crimped / max / final (mm)",
-                          " / ".join(f"{st[k]:.3f}" if num(st.get(k)) is not None else "-"
-                                     for k in ("axis_sagitta_initial", "axis_sagitta_at_max_diameter",
-                                               "axis_sagitta_final")), None),
-                         ("axis radius crimped / max / final (mm)",
-                          " / ".join(f"{st[k]:.1f}" if num(st.get(k)) is not None else "inf"
-                                     for k in ("axis_radius_initial", "axis_radius_at_max_diameter",
-                                               "axis_radius_final")), None)]
-                halves = [st.get(k) for k in ("axis_radius_halves_initial", "axis_radius_halves_at_max_diameter",
-                                              "axis_radius_halves_final")]
+                rows += [
+                    (
+                        "axis sagitta crimped / max / final (mm)",
+                        " / ".join(
+                            f"{st[k]:.3f}" if num(st.get(k)) is not None else "-"
+                            for k in ("axis_sagitta_initial", "axis_sagitta_at_max_diameter", "axis_sagitta_final")
+                        ),
+                        None,
+                    ),
+                    (
+                        "axis radius crimped / max / final (mm)",
+                        " / ".join(
+                            f"{st[k]:.1f}" if num(st.get(k)) is not None else "inf"
+                            for k in ("axis_radius_initial", "axis_radius_at_max_diameter", "axis_radius_final")
+                        ),
+                        None,
+                    ),
+                ]
+                halves = [
+                    st.get(k)
+                    for k in (
+                        "axis_radius_halves_initial",
+                        "axis_radius_halves_at_max_diameter",
+                        "axis_radius_halves_final",
+                    )
+                ]
                 if all(isinstance(h, list) and len(h) == 2 for h in halves):  # >= 5 rings (beam summary)
                     for i in (0, 1):
-                        rows.append((f"axis radius of half {i} crimped / max / final (mm)",
-                                     " / ".join(f"{h[i]:.1f}" if num(h[i]) is not None else "inf" for h in halves),
-                                     None))
+                        rows.append(
+                            (
+                                f"axis radius of half {i} crimped / max / final (mm)",
+                                " / ".join(f"{h[i]:.1f}" if num(h[i]) is not None else "inf" for h in halves),
+                                None,
+                            )
+                        )
     if solid:
         out["solid"] = {k: v for k, v in solid.items() if k != "steps"}
         for k, v in solid.items():
             if isinstance(v, (int, float)) and not isinstance(v, bool) and k != "apposition_threshold":
                 rows.append((f"solid {k}", v, None))
-        dog = [(num(get(s, "balloon_outer_diameter", "dogboning")), s) for s in (solid.get("steps") or [])
-               if isinstance(s, dict)]
+        dog = [
+            (num(get(s, "balloon_outer_diameter", "dogboning")), s)
+            for s in (solid.get("steps") or [])
+            if isinstance(s, dict)
+        ]
         dog = [(v, s) for v, s in dog if v is not None]
         if dog:
             top, at = max(dog, key=lambda x: x[0])
@@ -581,8 +701,10 @@ def main(run_dir):
                 press = [at["balloon_pressure"]]  # an artery scene also has the blood pressure
             out["solid"]["balloon_dogboning_max_percent"] = 100 * top
             out["solid"]["time_of_balloon_dogboning_max"] = at.get("time")
-            rows += [("balloon dogboning max (%)", 100 * top, None),
-                     ("  at pressure (atm)", press[0] / ATM if press else "-", None)]
+            rows += [
+                ("balloon dogboning max (%)", 100 * top, None),
+                ("  at pressure (atm)", press[0] / ATM if press else "-", None),
+            ]
     if artery:
         rows += artery[0][1]
         out["artery"] = artery[1]
@@ -590,11 +712,16 @@ def main(run_dir):
         out["coupling"] = coupling
         it_mean, it_max = num(coupling.get("coupling_iterations_mean")), coupling.get("coupling_iterations_max")
         share = num(coupling.get("messaging_share"))
-        rows += [("load steps", coupling.get("steps"), None),
-                 ("coupling iterations mean / max",
-                  f'{it_mean:.2f} / {it_max}' if it_mean is not None else f"- / {it_max}", None),
-                 ("wall time (s)", coupling.get("wall_time"), None),
-                 ("messaging share (%)", 100 * share if share is not None else None, None)]
+        rows += [
+            ("load steps", coupling.get("steps"), None),
+            (
+                "coupling iterations mean / max",
+                f"{it_mean:.2f} / {it_max}" if it_mean is not None else f"- / {it_max}",
+                None,
+            ),
+            ("wall time (s)", coupling.get("wall_time"), None),
+            ("messaging share (%)", 100 * share if share is not None else None, None),
+        ]
 
     rows = [r for r in rows if r[1] is not None]  # what a run did not write is skipped
     if rows:
@@ -607,7 +734,7 @@ def main(run_dir):
                 o = f"{'-' if ours is None else str(ours):>12}"
             p = f"{paper:8.4g}" if isinstance(paper, (int, float)) else f"{'':>8}"
             print(f"{name.ljust(w)}  {o}  {p}")
-        for note in (artery[1]["notes"] if artery else []):
+        for note in artery[1]["notes"] if artery else []:
             print(f"report: note: {note}")
     else:
         print(f"report: {run}: no summaries found (beam/summary.json, solid/summary.json, coupling_summary.json)")
@@ -626,23 +753,38 @@ def main(run_dir):
         if steps_csv:
             pts = [(p_of_t[key_t(s["time"])], s.get("diameter")) for s in bsteps if key_t(s["time"]) in p_of_t]
             if pts:
-                plot(run / "diameter_vs_pressure.png", [p for p, _ in pts], [d for _, d in pts],
-                     "balloon pressure (atm)", "stent diameter (mm)")
+                plot(
+                    run / "diameter_vs_pressure.png",
+                    [p for p, _ in pts],
+                    [d for _, d in pts],
+                    "balloon pressure (atm)",
+                    "stent diameter (mm)",
+                )
                 written.append("diameter_vs_pressure.png")
     if artery:
         pl = artery[2]
         if pl["stress"]:
-            plot_lines(run / "stress_vs_time.png", pl["stress"], "pseudo-time t (s)",
-                       "max first principal stress (kPa); dashed: p99, dotted: nodal max", logy=True)
+            plot_lines(
+                run / "stress_vs_time.png",
+                pl["stress"],
+                "pseudo-time t (s)",
+                "max first principal stress (kPa); dashed: p99, dotted: nodal max",
+                logy=True,
+            )
             written.append("stress_vs_time.png")
         if pl["lumen"]:
-            plot_lines(run / "lumen_profile.png", pl["lumen"],
-                       "station along the vessel axis (mm)" if pl["lumen_x"] == "station" else "station index",
-                       "lumen diameter (mm)", span=pl["span"])
+            plot_lines(
+                run / "lumen_profile.png",
+                pl["lumen"],
+                "station along the vessel axis (mm)" if pl["lumen_x"] == "station" else "station index",
+                "lumen diameter (mm)",
+                span=pl["span"],
+            )
             written.append("lumen_profile.png")
         if pl["force"]:
-            plot_lines(run / "contact_force_vs_time.png", pl["force"], "pseudo-time t (s)",
-                       "contact force on the artery (N)")
+            plot_lines(
+                run / "contact_force_vs_time.png", pl["force"], "pseudo-time t (s)", "contact force on the artery (N)"
+            )
             written.append("contact_force_vs_time.png")
     written = [n for n in written if (run / n).is_file()]
     print(f"report: {run / 'results.json'}" + (f" and {', '.join(written)}" if written else ""))

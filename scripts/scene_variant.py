@@ -76,8 +76,16 @@ def resolve_scene(name):
 
 
 def launch_command(scene_path, run_dir, build_dir, *options):
-    return [sys.executable, os.path.join(ROOT, "scripts", "launch.py"), scene_path, "--run-dir", run_dir,
-            "--build-dir", build_dir, *options]
+    return [
+        sys.executable,
+        os.path.join(ROOT, "scripts", "launch.py"),
+        scene_path,
+        "--run-dir",
+        run_dir,
+        "--build-dir",
+        build_dir,
+        *options,
+    ]
 
 
 def coupling_settings(scene_path, build_dir):

@@ -86,8 +86,14 @@ def load_study(path):
             if not isinstance(name, str) or not name.strip():
                 fail(f"{where}: name: expected a non-empty string, got {name!r}")
             if name in names:
-                fail(f"{where}: name: " + ("'baseline' names the unchanged run, expected another name"
-                                           if name == "baseline" else f"'{name}' is given twice"))
+                fail(
+                    f"{where}: name: "
+                    + (
+                        "'baseline' names the unchanged run, expected another name"
+                        if name == "baseline"
+                        else f"'{name}' is given twice"
+                    )
+                )
             names.add(name)
             if not isinstance(c.get("set"), dict) or not c["set"]:
                 fail(f"{where} ({name}): set: expected a map of dotted key paths to values, got {c.get('set')!r}")
@@ -101,8 +107,9 @@ def columns(rows):
     """The table's outputs: diameters, then per layer (in results.json order) max/p99 at peak, after."""
     names = [n for r in rows for n in r["outputs"]]
     layers = dict.fromkeys(n.split("_max_")[0] for n in names if "_max_" in n)
-    return ["D_peak", "D_final"] + [f"{layer}_{s}_{ph}" for ph in ("peak", "after") for layer in layers
-                                    for s in ("max", "p99")]
+    return ["D_peak", "D_final"] + [
+        f"{layer}_{s}_{ph}" for ph in ("peak", "after") for layer in layers for s in ("max", "p99")
+    ]
 
 
 def cell(r, name, is_base):
@@ -121,8 +128,13 @@ def main():
     ap.add_argument("study")
     ap.add_argument("--out-dir")
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
-    ap.add_argument("--reuse", action="append", default=[], metavar="JSON|RUN_DIR",
-                    help="an earlier sensitivity.json, or a finished run directory (repeatable)")
+    ap.add_argument(
+        "--reuse",
+        action="append",
+        default=[],
+        metavar="JSON|RUN_DIR",
+        help="an earlier sensitivity.json, or a finished run directory (repeatable)",
+    )
     ap.add_argument("--only", nargs="+", metavar="NAME", help="run the baseline and these changes only")
     a = ap.parse_args()
     base_path, runs = load_study(a.study)
@@ -165,8 +177,9 @@ def main():
         print(f"[sensitivity]   {r['status']}, {r['wall_s']:.1f} s", file=sys.stderr, flush=True)
     base_out = rows[0]["outputs"]
     for r in rows:
-        r["diff_percent"] = {k: 100.0 * (v - base_out[k]) / abs(base_out[k]) for k, v in r["outputs"].items()
-                             if base_out.get(k)}
+        r["diff_percent"] = {
+            k: 100.0 * (v - base_out[k]) / abs(base_out[k]) for k, v in r["outputs"].items() if base_out.get(k)
+        }
     with open(os.path.join(out_dir, "sensitivity.json"), "w") as f:
         json.dump({"study": os.path.abspath(a.study), "scene": base_path, "runs": rows}, f, indent=1)
     names = list(dict.fromkeys(n for r in rows for n in r["outputs"]))
@@ -174,16 +187,22 @@ def main():
         w = csv.writer(f)
         w.writerow(["name", "status", "wall_s", "reused", "run"] + names + [f"diff_percent_{n}" for n in names])
         for r in rows:
-            w.writerow([r["name"], r["status"], f"{r['wall_s']:.2f}", r["reused"], r["run"]]
-                       + [r["outputs"].get(n, "") for n in names] + [r["diff_percent"].get(n, "") for n in names])
+            w.writerow(
+                [r["name"], r["status"], f"{r['wall_s']:.2f}", r["reused"], r["run"]]
+                + [r["outputs"].get(n, "") for n in names]
+                + [r["diff_percent"].get(n, "") for n in names]
+            )
     cols = columns(rows)
     heads = [c.replace("_", " ") + (" (mm)" if c.startswith("D_") else " (MPa)") for c in cols]
     print(f"scene {base_path}, study {a.study}\n")
     print("| run | status | wall (s) | " + " | ".join(heads) + " |")
     print("|---|---|---:|" + "---:|" * len(cols))
     for i, r in enumerate(rows):
-        print(f"| {r['name']} | {r['status']} | {r['wall_s']:.0f}{' (reused)' if r['reused'] else ''} | "
-              + " | ".join(cell(r, c, i == 0) for c in cols) + " |")
+        print(
+            f"| {r['name']} | {r['status']} | {r['wall_s']:.0f}{' (reused)' if r['reused'] else ''} | "
+            + " | ".join(cell(r, c, i == 0) for c in cols)
+            + " |"
+        )
     print(f"\n(runs in {out_dir}; sensitivity.json/.csv)")
     return 0 if all(r["status"] == "ok" for r in rows) else 1
 

@@ -14,6 +14,8 @@ PACKAGES=(
   slurm-client slurmctld slurmd munge
   # participants in separate network namespaces (tests/integration/test_network_namespaces.py)
   iproute2
+  # format and lint (scripts/lint.sh)
+  clang-format black python3-flake8
 )
 
 missing=()

@@ -52,7 +52,8 @@ def check_scenes(study, cases, build_dir):
             out = subprocess.run(launch_command(path, "unused", build_dir, "--check"), capture_output=True, text=True)
         if out.returncode != 0:
             why = (out.stderr.strip() or out.stdout.strip()).splitlines()
-            fail(f"{study.where}: case {c.index} {c.params}: the scene is not valid: {why[-1] if why else out.returncode}")
+            why = why[-1] if why else out.returncode
+            fail(f"{study.where}: case {c.index} {c.params}: the scene is not valid: {why}")
 
 
 def cmd_run(a, study, out_dir):
@@ -70,22 +71,36 @@ def cmd_run(a, study, out_dir):
             todo.append(c)
         else:
             skipped[st] = skipped.get(st, 0) + 1
-    print(f"[study] {study.name}: {len(study.cases)} cases, {len(todo)} to run"
-          + "".join(f", {n} {s}" for s, n in skipped.items()) + f" ({out_dir})", file=sys.stderr)
+    print(
+        f"[study] {study.name}: {len(study.cases)} cases, {len(todo)} to run"
+        + "".join(f", {n} {s}" for s, n in skipped.items())
+        + f" ({out_dir})",
+        file=sys.stderr,
+    )
     if not todo:
         return finish(study, out_dir)
     if not a.no_check:
         check_scenes(study, todo, a.build_dir)
     if a.runner == "slurm":
         try:
-            job = submit(study, todo, out_dir, os.path.abspath(a.build_dir), sys.executable, ROOT,
-                         extra=a.sbatch_option, dry_run=a.dry_run)
+            job = submit(
+                study,
+                todo,
+                out_dir,
+                os.path.abspath(a.build_dir),
+                sys.executable,
+                ROOT,
+                extra=a.sbatch_option,
+                dry_run=a.dry_run,
+            )
         except RuntimeError as e:
             print(f"study: {e}", file=sys.stderr)
             return 1
         if job:
-            print(f"[study] submitted job array {job} ({len(todo)} tasks); follow with: "
-                  f"scripts/study.py status {a.study}" + (f" --out-dir {a.out_dir}" if a.out_dir else ""))
+            print(
+                f"[study] submitted job array {job} ({len(todo)} tasks); follow with: "
+                f"scripts/study.py status {a.study}" + (f" --out-dir {a.out_dir}" if a.out_dir else "")
+            )
         return 0
     if a.dry_run:
         for c in todo:
@@ -110,8 +125,10 @@ def print_status(study, rows):
     for r in rows:
         wall = f"{r['wall_s']:.1f} s" if isinstance(r.get("wall_s"), (int, float)) else "-"
         params = ", ".join(f"{k}={r[k]}" for k in names if k in r)
-        print(f"  {r['index']:>4}  {r['case']}  {r['state']:<8} {wall:>9}  {params}"
-              + (f"  ({r['message']})" if r["message"] else ""))
+        print(
+            f"  {r['index']:>4}  {r['case']}  {r['state']:<8} {wall:>9}  {params}"
+            + (f"  ({r['message']})" if r["message"] else "")
+        )
 
 
 def cmd_status(a, study, out_dir):
@@ -125,10 +142,14 @@ def cmd_case(a, study, out_dir):
         fail(f"--index: expected 0..{len(study.cases) - 1}, got {a.index}")
     c = study.cases[a.index]
     if a.key and a.key != c.key:
-        fail(f"{study.where}: case {a.index} is {c.key} now, {a.key} when it was submitted: "
-             "the study file changed since; submit again")
+        fail(
+            f"{study.where}: case {a.index} is {c.key} now, {a.key} when it was submitted: "
+            "the study file changed since; submit again"
+        )
     info = run_case(study, c, out_dir, a.build_dir)
-    print(f"[study] case {c.index} ({c.key}): {info['state']}" + (f": {info['message']}" if info.get("message") else ""))
+    print(
+        f"[study] case {c.index} ({c.key}): {info['state']}" + (f": {info['message']}" if info.get("message") else "")
+    )
     return 0 if info["state"] in ("done", "running") else 1
 
 
@@ -145,8 +166,13 @@ def main():
     r.add_argument("--retry-failed", action="store_true", help="run failed cases again")
     r.add_argument("--no-check", action="store_true", help="skip launch.py --check of every case")
     r.add_argument("--dry-run", action="store_true", help="say what would run or be submitted")
-    r.add_argument("--sbatch-option", action="append", default=[], metavar="OPT",
-                   help="slurm: an extra sbatch option, e.g. --sbatch-option=--account=lab (repeatable)")
+    r.add_argument(
+        "--sbatch-option",
+        action="append",
+        default=[],
+        metavar="OPT",
+        help="slurm: an extra sbatch option, e.g. --sbatch-option=--account=lab (repeatable)",
+    )
     sub.add_parser("status", parents=[common], help="state of every case")
     sub.add_parser("table", parents=[common], help="table.csv and plots from the finished cases")
     c = sub.add_parser("case", parents=[common], help="run one case (a Slurm array task)")
@@ -165,7 +191,8 @@ def main():
     except StudyError as e:
         fail(str(e))
     return {"run": cmd_run, "status": cmd_status, "table": lambda a, s, o: finish(s, o), "case": cmd_case}[a.command](
-        a, study, out_dir)
+        a, study, out_dir
+    )
 
 
 if __name__ == "__main__":

@@ -97,17 +97,32 @@ def _set_beam(s, n):
 
 def knobs(scene, quick, coupling):
     """coupling: the scene's coupling settings as run (scene_variant.coupling_settings)."""
-    t = scene.get("time", {})
     nw = scene.get("solid", {}).get("newton", {})
     g = scene.get("stent", {}).get("generator", {})
     out = {
         "steps": (_steps_levels(quick), _set_steps, 1.0, "load steps x", 2.0),
-        "coupling_tol": ([1e-2, 1e-3, 1e-4] if quick else [1e-2, 3e-3, 1e-3, 3e-4, 1e-4], _set_coupling_tol,
-                         coupling["rel_tol"], "coupling rel_tol", None),
-        "newton_tol": ([1e-4, 1e-6, 1e-8, 1e-10], _set_newton_tol, nw.get("rtol", 1e-8), "solid Newton rtol (atol alike)", 100.0),
+        "coupling_tol": (
+            [1e-2, 1e-3, 1e-4] if quick else [1e-2, 3e-3, 1e-3, 3e-4, 1e-4],
+            _set_coupling_tol,
+            coupling["rel_tol"],
+            "coupling rel_tol",
+            None,
+        ),
+        "newton_tol": (
+            [1e-4, 1e-6, 1e-8, 1e-10],
+            _set_newton_tol,
+            nw.get("rtol", 1e-8),
+            "solid Newton rtol (atol alike)",
+            100.0,
+        ),
         "mesh": ([1.0, 1.5, 2.0], _set_mesh, 1.0, "mesh refinement x", None),
-        "beam": ([2, 3] if quick else [2, 3, 4, 6], _set_beam, g.get("elements_per_strut", 3),
-                 "beam elements per strut", None),
+        "beam": (
+            [2, 3] if quick else [2, 3, 4, 6],
+            _set_beam,
+            g.get("elements_per_strut", 3),
+            "beam elements per strut",
+            None,
+        ),
     }
     if "generator" not in scene.get("stent", {}):
         out.pop("beam")
@@ -166,8 +181,12 @@ def run_scene(base_path, scene, out_dir, build_dir, cache, by="work_precision"):
         with open(run_dir + ".out", "w") as log:
             rc = subprocess.call(launch_command(path, run_dir, build_dir), stdout=log, stderr=subprocess.STDOUT)
         wall = time.time() - t0
-    r = {"run": key, "status": "ok" if rc == 0 else f"exit {rc}", "wall_s": wall,
-         "outputs": outputs_of(run_dir) if rc == 0 else {}}
+    r = {
+        "run": key,
+        "status": "ok" if rc == 0 else f"exit {rc}",
+        "wall_s": wall,
+        "outputs": outputs_of(run_dir) if rc == 0 else {},
+    }
     cache[key] = r
     return r
 
@@ -180,8 +199,12 @@ def reused_run_dir(path):
     scene = yaml.safe_load(open(given if os.path.isfile(given) else os.path.join(path, "scene.yaml")))
     summary = json.load(open(os.path.join(path, "coupling_summary.json")))
     status = summary["status"]
-    return {"run": scene_key(scene), "status": status, "wall_s": float(summary["wall_time"]),
-            "outputs": outputs_of(path) if status == "ok" else {}}
+    return {
+        "run": scene_key(scene),
+        "status": status,
+        "wall_s": float(summary["wall_time"]),
+        "outputs": outputs_of(path) if status == "ok" else {},
+    }
 
 
 # ------------------------------------------------------------------------------------------------
@@ -196,13 +219,18 @@ def richardson(values, ratio):
     p = math.log(abs(d1) / abs(d2)) / math.log(ratio)
     if not 0.5 <= p <= 8:
         return None, None
-    return q3 + d2 / (ratio ** p - 1.0), p
+    return q3 + d2 / (ratio**p - 1.0), p
 
 
 def analyse(knob_runs, tol):
     """Errors per run and output, the reference used, and the verdict."""
-    verdict = {"dominant_at_shipped": None, "cheapest_within_tol": {}, "shipped_errors": {}, "orders": {},
-               "not_estimated": {}}
+    verdict = {
+        "dominant_at_shipped": None,
+        "cheapest_within_tol": {},
+        "shipped_errors": {},
+        "orders": {},
+        "not_estimated": {},
+    }
     worst = (0.0, None)
     for knob, k in knob_runs.items():
         runs = [r for r in k["runs"] if r["status"] == "ok"]
@@ -223,21 +251,26 @@ def analyse(knob_runs, tol):
         shipped = [r for r in runs if r["shipped"]]
         # the shipped run as its own reference (finest of the ladder, no Richardson value): its
         # error is unknown, not zero; what is known is how far the next coarser level lies from it
-        own_ref = bool(shipped) and shipped[0] is runs[-1] and all(
-            v == "finest" for v in shipped[0].get("reference", {}).values())
+        own_ref = (
+            bool(shipped)
+            and shipped[0] is runs[-1]
+            and all(v == "finest" for v in shipped[0].get("reference", {}).values())
+        )
         if own_ref:
             coarser = runs[-2] if len(runs) > 1 else None
             verdict["not_estimated"][knob] = {
                 "next_coarser_level": coarser["level"] if coarser else None,
-                "its_difference": max(coarser.get("errors", {}).values(), default=0.0) if coarser else None}
+                "its_difference": max(coarser.get("errors", {}).values(), default=0.0) if coarser else None,
+            }
         elif shipped:
             e = shipped[0].get("errors", {})
             verdict["shipped_errors"][knob] = e
             m = max(e.values(), default=0.0)
             if m > worst[0]:
                 worst = (m, knob)
-        ok = [r for r in runs if r.get("errors") and max(r["errors"].values()) <= tol
-              and not (own_ref and r is runs[-1])]
+        ok = [
+            r for r in runs if r.get("errors") and max(r["errors"].values()) <= tol and not (own_ref and r is runs[-1])
+        ]
         if ok:
             best = min(ok, key=lambda r: r["wall_s"])
             verdict["cheapest_within_tol"][knob] = {"level": best["level"], "wall_s": best["wall_s"]}
@@ -247,9 +280,11 @@ def analyse(knob_runs, tol):
 
 def plot(knob_runs, path):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import matplotlib.ticker
+
     names = sorted(set().union(*(r.get("errors", {}) for k in knob_runs.values() for r in k["runs"])))
     if not names:
         return False
@@ -258,8 +293,11 @@ def plot(knob_runs, path):
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.4 * rows), squeeze=False)
     for ax, name in zip(axes.flat, names):
         for i, (knob, k) in enumerate(knob_runs.items()):
-            pts = [(r["wall_s"], r["errors"][name], r["shipped"]) for r in k["runs"]
-                   if r.get("errors", {}).get(name, 0) > 0]
+            pts = [
+                (r["wall_s"], r["errors"][name], r["shipped"])
+                for r in k["runs"]
+                if r.get("errors", {}).get(name, 0) > 0
+            ]
             if not pts:
                 continue
             pts.sort()
@@ -276,7 +314,7 @@ def plot(knob_runs, path):
         ax.set_ylabel("relative error")
         ax.grid(True, which="both", alpha=0.3)
     axes.flat[0].legend(fontsize=7)
-    for ax in list(axes.flat)[len(names):]:
+    for ax in list(axes.flat)[len(names) :]:
         ax.axis("off")
     fig.suptitle("error against run time (star: shipped setting)", fontsize=10)
     fig.tight_layout()
@@ -292,13 +330,23 @@ def main():
     ap.add_argument("--tol", type=float, default=0.01, help="relative error a setting must keep (default 1 %%)")
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "work_precision"))
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
-    ap.add_argument("--reuse", action="append", default=[], metavar="JSON|RUN_DIR",
-                    help="take the runs of an earlier work_precision.json, or a run directory of launch.py, "
-                         "instead of running them again (matched by the variant scene's hash; repeatable), "
-                         "e.g. to draw ladders run separately in one diagram or to use a long run made before")
-    ap.add_argument("--levels", action="append", default=[], metavar="KNOB=V1,V2",
-                    help="run these settings of a knob instead of its ladder (the shipped one is always "
-                         "included; repeatable), e.g. coupling_tol=1e-2 for a scene whose runs take an hour")
+    ap.add_argument(
+        "--reuse",
+        action="append",
+        default=[],
+        metavar="JSON|RUN_DIR",
+        help="take the runs of an earlier work_precision.json, or a run directory of launch.py, "
+        "instead of running them again (matched by the variant scene's hash; repeatable), "
+        "e.g. to draw ladders run separately in one diagram or to use a long run made before",
+    )
+    ap.add_argument(
+        "--levels",
+        action="append",
+        default=[],
+        metavar="KNOB=V1,V2",
+        help="run these settings of a knob instead of its ladder (the shipped one is always "
+        "included; repeatable), e.g. coupling_tol=1e-2 for a scene whose runs take an hour",
+    )
     a = ap.parse_args()
     if not (a.tol > 0 and math.isfinite(a.tol)):
         print(f"work_precision: --tol: expected a positive number, got {a.tol}", file=sys.stderr)
@@ -319,7 +367,9 @@ def main():
     chosen = a.knobs.split(",") if a.knobs else (["steps", "coupling_tol", "beam"] if a.quick else list(all_knobs))
     for k in chosen:
         if k not in all_knobs:
-            print(f"work_precision: --knobs: unknown knob '{k}', expected some of {','.join(all_knobs)}", file=sys.stderr)
+            print(
+                f"work_precision: --knobs: unknown knob '{k}', expected some of {','.join(all_knobs)}", file=sys.stderr
+            )
             return 2
     cache = {}
     for path in a.reuse:
@@ -333,22 +383,31 @@ def main():
                 for r in kr["runs"]:
                     cache[r["run"]] = {k: r[k] for k in ("run", "status", "wall_s", "outputs")}
         except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError) as e:
-            print(f"work_precision: --reuse {path}: expected a work_precision.json or a run directory of "
-                  f"launch.py (scene.yaml, coupling_summary.json), got {e}", file=sys.stderr)
+            print(
+                f"work_precision: --reuse {path}: expected a work_precision.json or a run directory of "
+                f"launch.py (scene.yaml, coupling_summary.json), got {e}",
+                file=sys.stderr,
+            )
             return 2
     for spec in a.levels:
         knob, _, values = spec.partition("=")
         if knob not in chosen:
-            print(f"work_precision: --levels {spec}: '{knob}' is not among the knobs run "
-                  f"({','.join(chosen)}; see --knobs)", file=sys.stderr)
+            print(
+                f"work_precision: --levels {spec}: '{knob}' is not among the knobs run "
+                f"({','.join(chosen)}; see --knobs)",
+                file=sys.stderr,
+            )
             return 2
         try:
             levels = [int(v) if knob == "beam" else float(v) for v in values.split(",")]
         except ValueError:
             levels = []
         if not levels or not all(math.isfinite(v) and v > 0 for v in levels):
-            print(f"work_precision: --levels {spec}: expected {knob}=V1[,V2...] with positive "
-                  f"{'integers' if knob == 'beam' else 'numbers'}", file=sys.stderr)
+            print(
+                f"work_precision: --levels {spec}: expected {knob}=V1[,V2...] with positive "
+                f"{'integers' if knob == 'beam' else 'numbers'}",
+                file=sys.stderr,
+            )
             return 2
         all_knobs[knob] = (levels,) + all_knobs[knob][1:]
     os.makedirs(a.out_dir, exist_ok=True)
@@ -377,9 +436,11 @@ def main():
         w.writerow(["knob", "level", "shipped", "status", "wall_s"] + names + [f"err_{n}" for n in names])
         for k, kr in knob_runs.items():
             for r in kr["runs"]:
-                w.writerow([k, r["level"], r["shipped"], r["status"], f"{r['wall_s']:.2f}"]
-                           + [r["outputs"].get(n, "") for n in names]
-                           + [r.get("errors", {}).get(n, "") for n in names])
+                w.writerow(
+                    [k, r["level"], r["shipped"], r["status"], f"{r['wall_s']:.2f}"]
+                    + [r["outputs"].get(n, "") for n in names]
+                    + [r.get("errors", {}).get(n, "") for n in names]
+                )
     png = os.path.join(a.out_dir, "work_precision.png")
     have_png = plot(knob_runs, png)
     print(f"scene {base_path}")
@@ -387,17 +448,28 @@ def main():
         for r in kr["runs"]:
             e = r.get("errors", {})
             worst = max(e.items(), key=lambda kv: kv[1]) if e else ("-", float("nan"))
-            print(f"  {k:<13}{str(r['level']):>8}{'*' if r['shipped'] else ' '} {r['status']:<8}{r['wall_s']:>8.1f} s"
-                  f"   worst error {worst[1]:.2e} ({worst[0]})")
+            print(
+                f"  {k:<13}{str(r['level']):>8}{'*' if r['shipped'] else ' '} {r['status']:<8}{r['wall_s']:>8.1f} s"
+                f"   worst error {worst[1]:.2e} ({worst[0]})"
+            )
     dom = verdict["dominant_at_shipped"]
-    print(f"verdict: at the shipped settings the largest estimated error comes from '{dom}'"
-          f" ({max(verdict['shipped_errors'].get(dom, {}).values(), default=0):.2e})" if dom else
-          "verdict: no knob with an estimated error changes the outputs measurably at the shipped settings")
+    print(
+        f"verdict: at the shipped settings the largest estimated error comes from '{dom}'"
+        f" ({max(verdict['shipped_errors'].get(dom, {}).values(), default=0):.2e})"
+        if dom
+        else "verdict: no knob with an estimated error changes the outputs measurably at the shipped settings"
+    )
     for k, ne in verdict["not_estimated"].items():
-        diff = (f"; the next coarser level ({ne['next_coarser_level']}) differs from it by up to "
-                f"{ne['its_difference']:.2e}" if ne["next_coarser_level"] is not None else "")
-        print(f"  {k}: the shipped setting is the finest of this ladder, its own error is not estimated{diff} "
-              f"(add finer levels: --levels, or the full ladder without --quick)")
+        diff = (
+            f"; the next coarser level ({ne['next_coarser_level']}) differs from it by up to "
+            f"{ne['its_difference']:.2e}"
+            if ne["next_coarser_level"] is not None
+            else ""
+        )
+        print(
+            f"  {k}: the shipped setting is the finest of this ladder, its own error is not estimated{diff} "
+            f"(add finer levels: --levels, or the full ladder without --quick)"
+        )
     for k, c in verdict["cheapest_within_tol"].items():
         print(f"  cheapest {k} keeping every output within {100 * a.tol:g} %: {c['level']} ({c['wall_s']:.1f} s)")
     for k, o in verdict["orders"].items():

@@ -14,7 +14,7 @@ AxisBow axis_bow(const Vec3& end0, const Vec3& middle, const Vec3& end1) {
   const double cross = a.cross(c).norm();  // = chord · sagitta
   b.sagitta = b.chord > 0 ? cross / b.chord : a.norm();
   b.radius = cross > 1e-12 * a.norm() * c.norm() ? a.norm() * c.norm() * b.chord / (2.0 * cross)
-                                                  : std::numeric_limits<double>::infinity();
+                                                 : std::numeric_limits<double>::infinity();
   return b;
 }
 

@@ -15,10 +15,8 @@ struct Q {
 
 template <class T>
 Q<T> qmul(const Q<T>& a, const Q<T>& b) {
-  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
-          a.w * b.x + b.w * a.x + (a.y * b.z - a.z * b.y),
-          a.w * b.y + b.w * a.y + (a.z * b.x - a.x * b.z),
-          a.w * b.z + b.w * a.z + (a.x * b.y - a.y * b.x)};
+  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + b.w * a.x + (a.y * b.z - a.z * b.y),
+          a.w * b.y + b.w * a.y + (a.z * b.x - a.x * b.z), a.w * b.z + b.w * a.z + (a.x * b.y - a.y * b.x)};
 }
 template <class T>
 Q<T> qconst(const Quat& q) {
@@ -46,8 +44,8 @@ Q<T> qsmall(const T* th) {
 // shortest-arc quaternion.
 template <class T>
 void relative_rotation(const Q<T>& L1, const Q<T>& L2, T* phi, Q<T>& qr) {
-  using std::sqrt;
   using std::atan2;
+  using std::sqrt;
   Q<T> rel = qmul(qconj(L1), L2);
   if (val(rel.w) < 0.0) rel = {-rel.w, -rel.x, -rel.y, -rel.z};
   // φ = log(rel) = 2 atan2(|v|, w) v/|v| (series for small |v| keeps the derivatives finite)
@@ -70,8 +68,8 @@ void relative_rotation(const Q<T>& L1, const Q<T>& L2, T* phi, Q<T>& qr) {
 // Rotation part only: perturbations of the two nodal rotations (6 variables each set).
 // Returns φ (relative rotation vector, Λ1 frame) and Q = Λ_rᵀ as a row-major 3×3.
 template <class T>
-void rotation_kernel(const ElementReference& ref, const Quat& R1, const Quat& R2, const T* pe,
-                     const T* pd, T* phi, T* Qm) {
+void rotation_kernel(const ElementReference& ref, const Quat& R1, const Quat& R2, const T* pe, const T* pd, T* phi,
+                     T* Qm) {
   Q<T> L1 = qnormalize(qmul(qmul(qsmall(pe), qsmall(pd)), qconst<T>(R1 * ref.O1)));
   Q<T> L2 = qnormalize(qmul(qmul(qsmall(pe + 3), qsmall(pd + 3)), qconst<T>(R2 * ref.O2)));
   Q<T> qr;
@@ -95,8 +93,7 @@ void rotation_kernel(const ElementReference& ref, const Quat& R1, const Quat& R2
 
 // Convected strain (Γ, Ω) before subtracting the reference strains (Γ0, Ω0): the value part of
 // evaluate_element's computation, with the same arithmetic.
-Vec6 raw_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
-                const Quat& R2) {
+Vec6 raw_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1, const Quat& R2) {
   const double z[6] = {0, 0, 0, 0, 0, 0};
   double phi[3], Qm[9];
   rotation_kernel<double>(ref, R1, R2, z, z, phi, Qm);
@@ -126,8 +123,8 @@ struct Kinematics {
 
 constexpr int kRotDof[6] = {3, 4, 5, 9, 10, 11};
 
-void first_order_kinematics(const ElementReference& ref, const Vec3& x1, const Vec3& x2,
-                            const Quat& R1, const Quat& R2, Kinematics& k) {
+void first_order_kinematics(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1, const Quat& R2,
+                            Kinematics& k) {
   using D1 = Dual<double, 6>;
   const double iL = 1.0 / ref.L0;
   const Vec3 d0 = x2 - x1;
@@ -188,8 +185,7 @@ void petrov_galerkin_residual(const Kinematics& k, const Vec3& d, const Vec6& si
 //   Δ(d×n) = Δd×n + d×Δn = −[n]× Δd + [d]× Δn.
 // Only first derivatives of the kinematics enter (no geometric term from second derivatives of
 // the strains), and the result is not symmetric.
-void petrov_galerkin_tangent(const Kinematics& k, const Vec3& d, const Vec6& sig, const Mat6& C,
-                             Mat12& K) {
+void petrov_galerkin_tangent(const Kinematics& k, const Vec3& d, const Vec6& sig, const Mat6& C, Mat12& K) {
   using Mat3x12 = Eigen::Matrix<double, 3, 12>;
   const Eigen::Matrix<double, 6, 12> CB = C * k.B;
   Mat3x12 Dn = k.Q.transpose() * CB.topRows<3>();
@@ -211,9 +207,8 @@ void petrov_galerkin_tangent(const Kinematics& k, const Vec3& d, const Vec6& sig
   K.middleRows<3>(9) = Dm - half_Ddxn;
 }
 
-ElementResult evaluate_petrov_galerkin(const Section& sec, const ElementReference& ref,
-                                       const Vec3& x1, const Vec3& x2, const Quat& R1,
-                                       const Quat& R2, const PlasticState& committed,
+ElementResult evaluate_petrov_galerkin(const Section& sec, const ElementReference& ref, const Vec3& x1, const Vec3& x2,
+                                       const Quat& R1, const Quat& R2, const PlasticState& committed,
                                        bool with_tangent) {
   ElementResult out;
   Kinematics k;
@@ -230,7 +225,6 @@ ElementResult evaluate_petrov_galerkin(const Section& sec, const ElementReferenc
 }
 
 }  // namespace
-
 
 Quat quat_exp(const Vec3& th) {
   const double a = th.norm();
@@ -264,8 +258,7 @@ Quat triad_from_tangent(const Vec3& t, const Vec3& up) {
   return Quat(R).normalized();
 }
 
-ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Quat& O1,
-                                        const Quat& O2) {
+ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Quat& O1, const Quat& O2) {
   ElementReference ref;
   ref.L0 = (X2 - X1).norm();
   ref.O1 = O1.normalized();
@@ -276,17 +269,16 @@ ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Qu
   return ref;
 }
 
-Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
-                    const Quat& R2) {
+Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1, const Quat& R2) {
   Vec6 s = raw_strain(ref, x1, x2, R1, R2);
   s.head<3>() -= ref.Gamma0;
   s.tail<3>() -= ref.Omega0;
   return s;
 }
 
-ElementResult evaluate_element(const Section& sec, const ElementReference& ref, const Vec3& x1,
-                               const Vec3& x2, const Quat& R1, const Quat& R2,
-                               const PlasticState& committed, bool with_tangent, ResidualForm form) {
+ElementResult evaluate_element(const Section& sec, const ElementReference& ref, const Vec3& x1, const Vec3& x2,
+                               const Quat& R1, const Quat& R2, const PlasticState& committed, bool with_tangent,
+                               ResidualForm form) {
   if (form == ResidualForm::petrov_galerkin)
     return evaluate_petrov_galerkin(sec, ref, x1, x2, R1, R2, committed, with_tangent);
   ElementResult out;

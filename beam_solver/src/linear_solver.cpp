@@ -22,7 +22,8 @@ class EigenBackend : public LinearSolver {
     }
     solver_.factorize(K);
     if (solver_.info() != Eigen::Success)
-      throw std::runtime_error(std::string(name_) + ": factorization failed (singular stiffness matrix? "
+      throw std::runtime_error(std::string(name_) +
+                               ": factorization failed (singular stiffness matrix? "
                                "check supports: rigid-body modes must be removed)");
     Eigen::VectorXd x = solver_.solve(b);
     if (solver_.info() != Eigen::Success) throw std::runtime_error(std::string(name_) + ": solve failed");

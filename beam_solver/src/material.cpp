@@ -15,8 +15,7 @@ Section circular_section(double E, double nu, double R, double shear_factor) {
   return s;
 }
 
-Section general_section(double E, double G, double A, double I2, double I3, double J, double k2,
-                        double k3) {
+Section general_section(double E, double G, double A, double I2, double I3, double J, double k2, double k3) {
   Section s;
   s.EA = E * A;
   s.GA2 = G * k2 * A;
@@ -80,8 +79,7 @@ SectionResponse evaluate_section(const Section& s, const Vec6& strain, const Pla
   r.bending_moment_norm = Mnorm;
   // Consistent tangent: EI [ HI/(EI+HI) n n^T + (Mnorm/|Mtr|)(I - n n^T) ].
   const Eigen::Matrix2d nn = n * n.transpose();
-  const Eigen::Matrix2d Cb =
-      EI * (s.HI / (EI + s.HI) * nn + (Mnorm / nMtr) * (Eigen::Matrix2d::Identity() - nn));
+  const Eigen::Matrix2d Cb = EI * (s.HI / (EI + s.HI) * nn + (Mnorm / nMtr) * (Eigen::Matrix2d::Identity() - nn));
   r.tangent.bottomRightCorner<2, 2>() = Cb;
   return r;
 }

@@ -20,17 +20,16 @@ void gauss_legendre_01(int n, std::vector<double>& xi, std::vector<double>& w) {
       {-0.7745966692414834, 0.0, 0.7745966692414834},
       {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526},
       {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640},
-      {-0.9324695142031521, -0.6612093864662645, -0.2386191860831969, 0.2386191860831969,
-       0.6612093864662645, 0.9324695142031521}};
+      {-0.9324695142031521, -0.6612093864662645, -0.2386191860831969, 0.2386191860831969, 0.6612093864662645,
+       0.9324695142031521}};
   static const std::vector<std::vector<double>> W = {
       {2.0},
       {1.0, 1.0},
       {0.5555555555555556, 0.8888888888888888, 0.5555555555555556},
       {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538},
-      {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-       0.2369268850561891},
-      {0.1713244923791704, 0.3607615730481386, 0.4679139345726910, 0.4679139345726910,
-       0.3607615730481386, 0.1713244923791704}};
+      {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891},
+      {0.1713244923791704, 0.3607615730481386, 0.4679139345726910, 0.4679139345726910, 0.3607615730481386,
+       0.1713244923791704}};
   if (n < 1 || n > 6) throw std::invalid_argument("sample points per element must be 1..6");
   xi.resize(n);
   w.resize(n);
@@ -151,8 +150,7 @@ void BeamModel::finalize() {
     if (!(fixed_.at(pr.node)[3] && fixed_[pr.node][4] && fixed_[pr.node][5]))
       throw std::invalid_argument("prescribed rotation needs all rotations of the node fixed");
   for (const auto& pd : prescribed_displacements)
-    if (!fixed_.at(pd.node).at(pd.comp))
-      throw std::invalid_argument("prescribed displacement on a free DOF");
+    if (!fixed_.at(pd.node).at(pd.comp)) throw std::invalid_argument("prescribed displacement on a free DOF");
   x_ = xc_ = X_;
   R_.assign(n, Quat::Identity());
   Rc_ = R_;
@@ -195,20 +193,18 @@ double BeamModel::sample_weight(int g) const {
   const int e = g / sample_points_per_element, k = g % sample_points_per_element;
   return gauss_w_[k] * eref_[e].L0;
 }
-double BeamModel::sample_radius(int g) const {
-  return element_section(g / sample_points_per_element).contact_radius;
-}
+double BeamModel::sample_radius(int g) const { return element_section(g / sample_points_per_element).contact_radius; }
 void BeamModel::set_sample_line_loads(const std::vector<Vec3>& q) {
   if (static_cast<int>(q.size()) != num_sample_points())
-    throw std::invalid_argument("expected " + std::to_string(num_sample_points()) +
-                                " sample line loads, got " + std::to_string(q.size()));
+    throw std::invalid_argument("expected " + std::to_string(num_sample_points()) + " sample line loads, got " +
+                                std::to_string(q.size()));
   q_ext_ = q;
 }
 void BeamModel::set_sample_planes(std::vector<SamplePlane> planes) {
   const std::size_t K = participant::planes_per_point(planes.size(), std::size_t(num_sample_points()));
   if (!planes.empty() && K == 0)
-    throw std::invalid_argument("expected K x " + std::to_string(num_sample_points()) +
-                                " contact planes, got " + std::to_string(planes.size()));
+    throw std::invalid_argument("expected K x " + std::to_string(num_sample_points()) + " contact planes, got " +
+                                std::to_string(planes.size()));
   planes_ = std::move(planes);
   planes_per_point_ = int(K);
 }
@@ -216,8 +212,9 @@ std::vector<Vec3> BeamModel::sample_contact_loads() const {
   std::vector<Vec3> q = q_ext_;
   for (size_t i = 0; i < planes_.size(); ++i) {
     const int g = int(i) / planes_per_point_;
-    q[g] += participant::plane_penalty(sample_position(g), planes_[i].s, planes_[i].n, planes_[i].eps,
-                                      sample_radius(g), planes_[i].g0).q;
+    q[g] += participant::plane_penalty(sample_position(g), planes_[i].s, planes_[i].n, planes_[i].eps, sample_radius(g),
+                                       planes_[i].g0)
+                .q;
   }
   return q;
 }
@@ -477,12 +474,10 @@ NewtonStats BeamModel::solve() {
     try {
       d = lin_->solve(K, -r);
     } catch (const std::exception& e) {
-      return finish(false, std::string("linear solve failed in iteration ") + std::to_string(it) +
-                               ": " + e.what() + "; residual history: " +
-                               log::list(st.residual_history));
+      return finish(false, std::string("linear solve failed in iteration ") + std::to_string(it) + ": " + e.what() +
+                               "; residual history: " + log::list(st.residual_history));
     }
-    if (!d.allFinite())
-      return finish(false, "Newton increment is NaN/Inf in iteration " + std::to_string(it));
+    if (!d.allFinite()) return finish(false, "Newton increment is NaN/Inf in iteration " + std::to_string(it));
     const auto xs = x_;
     const auto Rs = R_;
     double alpha = 1.0;
@@ -493,8 +488,8 @@ NewtonStats BeamModel::solve() {
       // Energy-norm line search (Crisfield): accept if the residual norm or the work of the
       // residual along the increment |d·r(α)| decreases; beams mix stiff axial and soft bending
       // modes, so the plain residual norm is a poor merit function early in the iteration.
-      const bool ok = std::isfinite(rnn) &&
-                      (!newton.line_search || rnn <= rn || std::abs(d.dot(rnew)) <= std::abs(d.dot(r)));
+      const bool ok =
+          std::isfinite(rnn) && (!newton.line_search || rnn <= rn || std::abs(d.dot(rnew)) <= std::abs(d.dot(r)));
       if (ok || ls >= newton.max_line_search) {
         if (!std::isfinite(rnn)) {
           rn = rnn;
@@ -515,16 +510,16 @@ NewtonStats BeamModel::solve() {
     st.residual_history.push_back(rn);
     st.increment_history.push_back(dn);
     if (rn > 1e8 * std::max(r0, newton.residual_tol))
-      return finish(false, "Newton diverged in iteration " + std::to_string(it) +
-                               " (residual grew by more than 1e8); residual history: " +
-                               log::list(st.residual_history));
+      return finish(false,
+                    "Newton diverged in iteration " + std::to_string(it) +
+                        " (residual grew by more than 1e8); residual history: " + log::list(st.residual_history));
     if (rn <= rtol && dn <= newton.increment_tol) return finish(true, "");
     // round-off floor: increment negligible and residual within 100× the tolerance
     if (dn <= 1e-3 * newton.increment_tol && rn <= 100.0 * rtol) return finish(true, "");
   }
   return finish(false, "Newton did not converge in " + std::to_string(newton.max_iterations) +
-                           " iterations; residual history: " + log::list(st.residual_history) +
-                           "; last increment " + std::to_string(dn));
+                           " iterations; residual history: " + log::list(st.residual_history) + "; last increment " +
+                           std::to_string(dn));
 }
 
 }  // namespace angio::beam

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "angio/common/h5_io.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,36 +18,6 @@
 namespace angio::beam {
 
 namespace {
-
-void write_dataset(hid_t loc, const std::string& name, const std::vector<double>& data,
-                   hsize_t rows, hsize_t cols) {
-  hsize_t dims[2] = {rows, cols};
-  const int rank = cols == 1 ? 1 : 2;
-  hid_t space = H5Screate_simple(rank, dims, nullptr);
-  hid_t ds = H5Dcreate2(loc, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  if (ds < 0) throw std::runtime_error("HDF5: cannot create dataset " + name);
-  if (rows > 0) H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
-  H5Dclose(ds);
-  H5Sclose(space);
-}
-
-void write_int_dataset(hid_t loc, const std::string& name, const std::vector<int>& data,
-                       hsize_t rows, hsize_t cols) {
-  hsize_t dims[2] = {rows, cols};
-  hid_t space = H5Screate_simple(2, dims, nullptr);
-  hid_t ds = H5Dcreate2(loc, name.c_str(), H5T_NATIVE_INT, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  if (ds < 0) throw std::runtime_error("HDF5: cannot create dataset " + name);
-  H5Dwrite(ds, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data());
-  H5Dclose(ds);
-  H5Sclose(space);
-}
-
-std::vector<double> flat(const std::vector<Vec3>& v) {
-  std::vector<double> out;
-  out.reserve(3 * v.size());
-  for (const auto& x : v) out.insert(out.end(), {x.x(), x.y(), x.z()});
-  return out;
-}
 
 // a number in the XDMF text (the summary is written with nlohmann::json)
 std::string num(double v) {
@@ -80,33 +52,24 @@ void BeamOutput::write_step(const BeamModel& m, int step, double time) {
   ne_ = m.num_elements();
   ng_ = m.num_sample_points();
   if (steps_.empty()) {
-    hid_t g = H5Gcreate2(f, "/mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    h5::H5Id g(H5Gcreate2(f, "/mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (g.id < 0) throw std::runtime_error("HDF5: cannot create group /mesh");
     std::vector<int> conn;
     for (int e = 0; e < ne_; ++e) {
       conn.push_back(m.element_nodes(e)[0]);
       conn.push_back(m.element_nodes(e)[1]);
     }
-    write_int_dataset(g, "connectivity", conn, ne_, 2);
+    h5::write_dataset(g, "connectivity", H5T_NATIVE_INT, ne_, 2, conn.data());
     std::vector<Vec3> X(nn_);
     for (int n = 0; n < nn_; ++n) X[n] = m.reference_position(n);
-    write_dataset(g, "reference_positions", flat(X), nn_, 3);
-    H5Gclose(g);
+    h5::write_rows(g, "reference_positions", X);
   }
   char name[64];
   std::snprintf(name, sizeof name, "/step_%06d", static_cast<int>(steps_.size()));
-  hid_t g = H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  if (g < 0) throw std::runtime_error(std::string("HDF5: cannot create group ") + name);
-  {
-    hsize_t one = 1;
-    hid_t sp = H5Screate_simple(1, &one, nullptr);
-    hid_t a = H5Acreate2(g, "time", H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_DOUBLE, &time);
-    H5Aclose(a);
-    hid_t b = H5Acreate2(g, "step", H5T_NATIVE_INT, sp, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(b, H5T_NATIVE_INT, &step);
-    H5Aclose(b);
-    H5Sclose(sp);
-  }
+  h5::H5Id g(H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  if (g.id < 0) throw std::runtime_error(std::string("HDF5: cannot create group ") + name);
+  h5::write_attribute(g, "time", H5T_NATIVE_DOUBLE, &time);
+  h5::write_attribute(g, "step", H5T_NATIVE_INT, &step);
   std::vector<Vec3> x(nn_), u(nn_), rv(nn_);
   std::vector<double> quat;
   for (int n = 0; n < nn_; ++n) {
@@ -116,11 +79,11 @@ void BeamOutput::write_step(const BeamModel& m, int step, double time) {
     const Quat& q = m.rotation(n);
     quat.insert(quat.end(), {q.w(), q.x(), q.y(), q.z()});
   }
-  write_dataset(g, "positions", flat(x), nn_, 3);
-  write_dataset(g, "displacement", flat(u), nn_, 3);
-  write_dataset(g, "rotation_vector", flat(rv), nn_, 3);
-  write_dataset(g, "rotation_quaternion_wxyz", quat, nn_, 4);
-  write_dataset(g, "contact_force", flat(m.sample_load_nodal_forces()), nn_, 3);
+  h5::write_rows(g, "positions", x);
+  h5::write_rows(g, "displacement", u);
+  h5::write_rows(g, "rotation_vector", rv);
+  h5::write_dataset(g, "rotation_quaternion_wxyz", H5T_NATIVE_DOUBLE, nn_, 4, quat.data());
+  h5::write_rows(g, "contact_force", m.sample_load_nodal_forces());
   std::vector<double> mb(ne_), kp(ne_), nx(ne_), mt(ne_);
   for (int e = 0; e < ne_; ++e) {
     mb[e] = m.bending_moment_norm(e);
@@ -129,15 +92,14 @@ void BeamOutput::write_step(const BeamModel& m, int step, double time) {
     nx[e] = s(0);
     mt[e] = s(3);
   }
-  write_dataset(g, "bending_moment_norm", mb, ne_, 1);
-  write_dataset(g, "accumulated_plastic_curvature", kp, ne_, 1);
-  write_dataset(g, "axial_force", nx, ne_, 1);
-  write_dataset(g, "torsion_moment", mt, ne_, 1);
+  h5::write_dataset(g, "bending_moment_norm", H5T_NATIVE_DOUBLE, ne_, 1, mb.data());
+  h5::write_dataset(g, "accumulated_plastic_curvature", H5T_NATIVE_DOUBLE, ne_, 1, kp.data());
+  h5::write_dataset(g, "axial_force", H5T_NATIVE_DOUBLE, ne_, 1, nx.data());
+  h5::write_dataset(g, "torsion_moment", H5T_NATIVE_DOUBLE, ne_, 1, mt.data());
   std::vector<Vec3> sx(ng_);
   for (int i = 0; i < ng_; ++i) sx[i] = m.sample_position(i);
-  write_dataset(g, "sample_positions", flat(sx), ng_, 3);
-  write_dataset(g, "contact_line_loads", flat(m.sample_contact_loads()), ng_, 3);
-  H5Gclose(g);
+  h5::write_rows(g, "sample_positions", sx);
+  h5::write_rows(g, "contact_line_loads", m.sample_contact_loads());
   H5Fflush(f, H5F_SCOPE_GLOBAL);
   steps_.push_back({step, time, std::string(name).substr(1)});
   write_xdmf();
@@ -158,15 +120,15 @@ void BeamOutput::write_xdmf() const {
   for (const auto& s : steps_) {
     const std::string G = "/" + s.group + "/";
     os << "<Grid Name=\"stent_" << s.step << "\" GridType=\"Uniform\">\n<Time Value=\"" << num(s.time)
-       << "\"/>\n<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << ne_
-       << "\">" << item("/mesh/connectivity", ne_, 2, "Int") << "</Topology>\n"
+       << "\"/>\n<Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" NumberOfElements=\"" << ne_ << "\">"
+       << item("/mesh/connectivity", ne_, 2, "Int") << "</Topology>\n"
        << "<Geometry GeometryType=\"XYZ\">" << item(G + "positions", nn_, 3) << "</Geometry>\n";
     for (const char* a : {"displacement", "rotation_vector", "contact_force"})
-      os << "<Attribute Name=\"" << a << "\" AttributeType=\"Vector\" Center=\"Node\">"
-         << item(G + a, nn_, 3) << "</Attribute>\n";
+      os << "<Attribute Name=\"" << a << "\" AttributeType=\"Vector\" Center=\"Node\">" << item(G + a, nn_, 3)
+         << "</Attribute>\n";
     for (const char* a : {"bending_moment_norm", "accumulated_plastic_curvature", "axial_force", "torsion_moment"})
-      os << "<Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Cell\">"
-         << item(G + a, ne_, 1) << "</Attribute>\n";
+      os << "<Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Cell\">" << item(G + a, ne_, 1)
+         << "</Attribute>\n";
     os << "</Grid>\n";
   }
   os << "</Grid>\n";
@@ -188,9 +150,8 @@ void BeamOutput::write_xdmf() const {
   std::filesystem::rename(tmp, dir_ + "/beam.xdmf");
 }
 
-std::string write_summary(const std::string& path, const BeamModel& m,
-                          const std::vector<StepRecord>& steps, bool generated_stent,
-                          const std::string& status, double newton_seconds,
+std::string write_summary(const std::string& path, const BeamModel& m, const std::vector<StepRecord>& steps,
+                          bool generated_stent, const std::string& status, double newton_seconds,
                           long newton_iterations, const StepRecord& initial) {
   using nlohmann::ordered_json;
   // non-finite numbers (e.g. the NaN stent measures of a model that is not a generated stent)
@@ -217,9 +178,8 @@ std::string write_summary(const std::string& path, const BeamModel& m,
       {"final", finite(Dfinal)},
       {"recoil", finite(Dmax - Dfinal)},
       {"recoil_percent", finite(Dmax > 0 ? 100.0 * (Dmax - Dfinal) / Dmax : 0.0)},
-      {"definition",
-       std::string("2 x mean radial distance of all nodes from the device axis") +
-           (generated_stent ? " of the deformed stent (polyline through the ring centroids)" : "")}};
+      {"definition", std::string("2 x mean radial distance of all nodes from the device axis") +
+                         (generated_stent ? " of the deformed stent (polyline through the ring centroids)" : "")}};
   if (generated_stent && !steps.empty()) {
     // dogboning = (D_distal − D_central)/D_distal; foreshortening = (L0 − L)/L0
     double dbmax = -1e300, tdb = 0;
@@ -230,9 +190,8 @@ std::string write_summary(const std::string& path, const BeamModel& m,
         tdb = s.time;
       }
     }
-    const auto& pk = *std::max_element(steps.begin(), steps.end(), [](const auto& a, const auto& b) {
-      return a.diameter < b.diameter;
-    });
+    const auto& pk = *std::max_element(steps.begin(), steps.end(),
+                                       [](const auto& a, const auto& b) { return a.diameter < b.diameter; });
     const auto& fin = steps.back();
     const double L0 = initial.length;
     j["stent"] = {

@@ -17,7 +17,8 @@ BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string&
     : scene_(std::move(scene)), run_dir_(run_dir) {
   if (scene_.initial_state) {
     apply_beam_state(*scene_.model, *scene_.initial_state);
-    LOG_INFO("beam: continuing from " << scene_.initial_state->path << " at t = " << scene_.initial_state->time << " s");
+    LOG_INFO("beam: continuing from " << scene_.initial_state->path << " at t = " << scene_.initial_state->time
+                                      << " s");
   }
   if (!run_dir_.empty()) {
     out_ = std::make_unique<BeamOutput>(run_dir_ + "/beam");
@@ -26,12 +27,12 @@ BeamSolverParticipant::BeamSolverParticipant(BeamScene scene, const std::string&
   const BeamModel& m = *scene_.model;
   initial_.diameter = m.diameter(true);
   if (scene_.stent) stent_measures(initial_, true);
-  LOG_INFO("beam model: " << m.num_nodes() << " nodes, " << m.num_elements() << " elements, "
-                          << m.num_free_dofs() << " free DOFs, " << m.num_sample_points()
-                          << " contact sample points, linear solver " << m.newton.linear_solver
+  LOG_INFO("beam model: " << m.num_nodes() << " nodes, " << m.num_elements() << " elements, " << m.num_free_dofs()
+                          << " free DOFs, " << m.num_sample_points() << " contact sample points, linear solver "
+                          << m.newton.linear_solver
                           << (m.residual_form == ResidualForm::petrov_galerkin ? ", Petrov-Galerkin residual" : "")
-                          << (scene_.generated_stent ? ", generated stent, diameter " : ", diameter ")
-                          << m.diameter() << " mm");
+                          << (scene_.generated_stent ? ", generated stent, diameter " : ", diameter ") << m.diameter()
+                          << " mm");
 }
 
 BeamSolverParticipant::~BeamSolverParticipant() = default;
@@ -123,8 +124,8 @@ participant::SolveStats BeamSolverParticipant::solve_loads_(const std::vector<pa
   if (!q.empty()) {
     if (static_cast<int>(q.size()) != m.num_sample_points()) {
       out.converged = false;
-      out.message = "expected " + std::to_string(m.num_sample_points()) + " line loads, got " +
-                    std::to_string(q.size());
+      out.message =
+          "expected " + std::to_string(m.num_sample_points()) + " line loads, got " + std::to_string(q.size());
       return out;
     }
     std::vector<Vec3> qq(q.size());
@@ -163,13 +164,7 @@ void BeamSolverParticipant::end_step(bool accept) {
   ++accepted_;
   double mmax = 0;
   for (int e = 0; e < m.num_elements(); ++e) mmax = std::max(mmax, m.bending_moment_norm(e));
-  StepRecord r{step_,
-               time_,
-               m.diameter(),
-               step_iterations_,
-               step_residual_,
-               mmax,
-               seconds_since(step_start_)};
+  StepRecord r{step_, time_, m.diameter(), step_iterations_, step_residual_, mmax, seconds_since(step_start_)};
   stent_measures(r, false);
   records_.push_back(r);
   last_written_ = false;
@@ -178,11 +173,10 @@ void BeamSolverParticipant::end_step(bool accept) {
     last_written_ = true;
     write_state_();
   }
-  LOG_INFO("beam step " << step_ << " t = " << time_ << " s: " << r.iterations << " it, |r| = "
-                        << std::scientific << std::setprecision(2) << r.residual << std::defaultfloat
-                        << ", D = " << std::setprecision(5) << r.diameter << " mm, max |M_b| = "
-                        << std::setprecision(4) << mmax << " N mm, " << std::setprecision(3)
-                        << r.wall_seconds << " s");
+  LOG_INFO("beam step " << step_ << " t = " << time_ << " s: " << r.iterations << " it, |r| = " << std::scientific
+                        << std::setprecision(2) << r.residual << std::defaultfloat << ", D = " << std::setprecision(5)
+                        << r.diameter << " mm, max |M_b| = " << std::setprecision(4) << mmax << " N mm, "
+                        << std::setprecision(3) << r.wall_seconds << " s");
 }
 
 void BeamSolverParticipant::write_state_() {
@@ -206,8 +200,7 @@ void BeamSolverParticipant::finish() {
     out_->close();
     const bool complete = !records_.empty() && records_.back().time >= scene_.time.end - 1e-12;
     write_summary(run_dir_ + "/beam/summary.json", m, records_, scene_.generated_stent,
-                  complete ? "completed" : "incomplete", newton_seconds_, iterations_total_,
-                  initial_);
+                  complete ? "completed" : "incomplete", newton_seconds_, iterations_total_, initial_);
     LOG_INFO("beam output written to " << run_dir_ << "/beam (beam.xdmf, beam.h5, summary.json)");
   }
 }

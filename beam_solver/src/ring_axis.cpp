@@ -5,8 +5,7 @@
 
 namespace angio::beam {
 
-std::optional<Axis> ring_centroid_axis(const std::vector<std::vector<int>>& ring_crowns,
-                                       const std::vector<Vec3>& x) {
+std::optional<Axis> ring_centroid_axis(const std::vector<std::vector<int>>& ring_crowns, const std::vector<Vec3>& x) {
   if (ring_crowns.size() < 2) return std::nullopt;
   Axis a;
   a.points.clear();

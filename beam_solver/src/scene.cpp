@@ -54,14 +54,12 @@ Section read_section(const Node& st) {
       k2 = f[0];
       k3 = f[1];
     }
-    s = general_section(E, G, sec.positive("A"), sec.positive("I2"), sec.positive("I3"),
-                        sec.positive("J"), k2, k3);
+    s = general_section(E, G, sec.positive("A"), sec.positive("I2"), sec.positive("I3"), sec.positive("J"), k2, k3);
   }
   if (sec.has("contact_radius")) s.contact_radius = sec.positive("contact_radius");
   if (auto pl = st.optional("plasticity")) {
     pl->check_keys({"yield_moment", "tangent_modulus"});
-    if (std::abs(s.EI2 - s.EI3) > 1e-12 * s.EI2)
-      pl->fail("a circular section (I2 == I3) for bending plasticity");
+    if (std::abs(s.EI2 - s.EI3) > 1e-12 * s.EI2) pl->fail("a circular section (I2 == I3) for bending plasticity");
     const double My0 = pl->positive("yield_moment");
     const double Eep = pl->non_negative("tangent_modulus");
     if (!(Eep < E)) pl->child("tangent_modulus").fail("a value below E");
@@ -128,9 +126,8 @@ BeamScene beam_scene_from(const Node& root) {
   bs.output = scene::output_settings(root);
   const scene::LoadCurves curves = scene::load_curves(root);
   const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
-  st.check_keys({"material", "plasticity", "section", "generator", "nodes", "elements", "lines",
-                 "up", "axis", "fixation", "supports", "loads", "solver", "contact", "triads",
-                 "element", "initial_state"});
+  st.check_keys({"material", "plasticity", "section", "generator", "nodes", "elements", "lines", "up", "axis",
+                 "fixation", "supports", "loads", "solver", "contact", "triads", "element", "initial_state"});
   bs.model = std::make_unique<BeamModel>();
   BeamModel& m = *bs.model;
   const int sec = m.add_section(read_section(st));
@@ -151,8 +148,8 @@ BeamScene beam_scene_from(const Node& root) {
   std::vector<int> fixation_default;
   if (auto g = st.optional("generator")) {
     if (st.has("nodes") || st.has("lines")) st.fail("either generator or nodes/elements/lines, not both");
-    g->check_keys({"type", "rings", "crowns", "crimped_diameter", "strut_height", "ring_pitch",
-                   "connectors", "elements_per_strut", "elements_per_connector", "centerline", "start"});
+    g->check_keys({"type", "rings", "crowns", "crimped_diameter", "strut_height", "ring_pitch", "connectors",
+                   "elements_per_strut", "elements_per_connector", "centerline", "start"});
     g->choice("type", {"corrugated_rings"});
     StentParameters p;
     p.rings = static_cast<int>(g->integer_or("rings", p.rings, 1, 1000));  // 1000 rings: a 1.5 m stent
@@ -213,8 +210,7 @@ BeamScene beam_scene_from(const Node& root) {
       const auto ab = els.at(i).as_numbers();
       if (ab.size() != 2) els.at(i).fail("[node1, node2]");
       const int a = static_cast<int>(ab[0]), b = static_cast<int>(ab[1]);
-      if (a < 0 || b < 0 || a >= m.num_nodes() || b >= m.num_nodes() || a == b ||
-          ab[0] != a || ab[1] != b)
+      if (a < 0 || b < 0 || a >= m.num_nodes() || b >= m.num_nodes() || a == b || ab[0] != a || ab[1] != b)
         els.at(i).fail("two different node indices in [0, " + std::to_string(m.num_nodes() - 1) + "]");
       if ((m.reference_position(a) - m.reference_position(b)).norm() <= 0)
         els.at(i).fail("an element of non-zero length");
@@ -250,9 +246,12 @@ BeamScene beam_scene_from(const Node& root) {
       }
       try {
         for (int n : nodes) {
-          if (std::string(kind) == "radial") m.fix_radial_only(n);
-          else if (std::string(kind) == "axial") m.fix_axial(n);
-          else m.fix_circumferential(n);
+          if (std::string(kind) == "radial")
+            m.fix_radial_only(n);
+          else if (std::string(kind) == "axial")
+            m.fix_axial(n);
+          else
+            m.fix_circumferential(n);
         }
       } catch (const std::invalid_argument& e) {
         r.fail(std::string("nodes off the device axis (") + e.what() + ")");
@@ -323,8 +322,8 @@ BeamScene beam_scene_from(const Node& root) {
   }
 
   if (auto so = st.optional("solver")) {
-    so->check_keys({"linear_solver", "max_iterations", "residual_tol", "residual_rel_tol",
-                    "increment_tol", "line_search"});
+    so->check_keys(
+        {"linear_solver", "max_iterations", "residual_tol", "residual_rel_tol", "increment_tol", "line_search"});
     m.newton.linear_solver = so->choice_or("linear_solver", {"umfpack", "klu", "sparselu"}, "klu");
     m.newton.max_iterations = static_cast<int>(so->integer_or("max_iterations", 30, 1));
     m.newton.residual_tol = so->positive_or("residual_tol", m.newton.residual_tol);

@@ -52,7 +52,8 @@ BeamState read_beam_state(const std::string& path) {
   BeamState s;
   s.path = path;
   const int format = r.attribute<int>(file, "format", H5T_NATIVE_INT);
-  if (format != kFormat) r.fail("state file format " + std::to_string(format) + ", this solver reads " + std::to_string(kFormat));
+  if (format != kFormat)
+    r.fail("state file format " + std::to_string(format) + ", this solver reads " + std::to_string(kFormat));
   s.time = r.attribute<double>(file, "time", H5T_NATIVE_DOUBLE);
   s.step = r.attribute<int>(file, "step", H5T_NATIVE_INT);
   if (!std::isfinite(s.time)) r.fail("time is not finite");
@@ -81,7 +82,8 @@ void check_beam_state(const BeamState& s, const BeamModel& m) {
                     " and " + std::to_string(m.num_elements()) + " (a different stent)");
   for (int n = 0; n < m.num_nodes(); ++n)
     if ((s.X[n] - m.reference_position(n)).norm() > kCoordinateTolerance)
-      throw h5::Error(s.path + ": node " + std::to_string(n) + " of the stent lies elsewhere in this scene (a different stent)");
+      throw h5::Error(s.path + ": node " + std::to_string(n) +
+                      " of the stent lies elsewhere in this scene (a different stent)");
 }
 
 void apply_beam_state(BeamModel& m, const BeamState& s) { m.start_from(s.time, s.x, s.R, s.plastic); }

@@ -27,9 +27,8 @@ struct Placement {
 };
 
 StentMesh generate(const StentParameters& p, const geometry::Centerline* centerline) {
-  if (p.rings < 1 || p.crowns < 2 || p.connectors < 0 || p.elements_per_strut < 1 ||
-      p.elements_per_connector < 1 || !(p.crimped_diameter > 0) || !(p.strut_height > 0) ||
-      !(p.ring_pitch > 0))
+  if (p.rings < 1 || p.crowns < 2 || p.connectors < 0 || p.elements_per_strut < 1 || p.elements_per_connector < 1 ||
+      !(p.crimped_diameter > 0) || !(p.strut_height > 0) || !(p.ring_pitch > 0))
     throw std::invalid_argument("invalid stent parameters");
   if (p.connectors > p.crowns) throw std::invalid_argument("more connectors than crowns");
   Placement W;
@@ -39,10 +38,9 @@ StentMesh generate(const StentParameters& p, const geometry::Centerline* centerl
     const double L = centerline->length();
     W.offset = p.start >= 0 ? p.start : 0.5 * (L - length);
     if (W.offset < 0 || W.offset + length > L + 1e-9)
-      throw std::invalid_argument("stent (" + std::to_string(length) +
-                                  " mm) does not fit on the centerline (" + std::to_string(L) +
-                                  " mm" + (p.start >= 0 ? ", starting at " + std::to_string(p.start) + " mm" : "") +
-                                  ")");
+      throw std::invalid_argument("stent (" + std::to_string(length) + " mm) does not fit on the centerline (" +
+                                  std::to_string(L) + " mm" +
+                                  (p.start >= 0 ? ", starting at " + std::to_string(p.start) + " mm" : "") + ")");
   }
   StentMesh m;
   const double r = 0.5 * p.crimped_diameter;
@@ -61,8 +59,7 @@ StentMesh generate(const StentParameters& p, const geometry::Centerline* centerl
       m.ring_crowns[k].push_back(crown_node[{k, j}]);
     }
   // a polyline on the cylinder from (th0, z0) to (th1, z1) with n elements
-  auto add_line = [&](int a, int b, double th0, double z0, double th1, double z1, int n, int kind,
-                      int group) {
+  auto add_line = [&](int a, int b, double th0, double z0, double th1, double z1, int n, int kind, int group) {
     int prev = a;
     for (int i = 1; i <= n; ++i) {
       const double f = static_cast<double>(i) / n;
@@ -78,8 +75,8 @@ StentMesh generate(const StentParameters& p, const geometry::Centerline* centerl
   for (int k = 0; k < p.rings; ++k)
     for (int j = 0; j < nc; ++j) {
       const int j1 = (j + 1) % nc;
-      add_line(crown_node[{k, j}], crown_node[{k, j1}], j * dth, crown_z(k, j), (j + 1) * dth,
-               crown_z(k, j1), p.elements_per_strut, 0, m.num_struts++);
+      add_line(crown_node[{k, j}], crown_node[{k, j1}], j * dth, crown_z(k, j), (j + 1) * dth, crown_z(k, j1),
+               p.elements_per_strut, 0, m.num_struts++);
     }
   for (int k = 0; k + 1 < p.rings; ++k)
     for (int i = 0; i < p.connectors; ++i) {
@@ -89,8 +86,7 @@ StentMesh generate(const StentParameters& p, const geometry::Centerline* centerl
       const int mcrown = static_cast<int>(std::lround(i * spacing + ((k % 2) ? 0.5 * spacing : 0.0))) % p.crowns;
       const int j = 2 * mcrown + 1;
       const int j1 = (j + 1) % nc;
-      add_line(crown_node[{k, j}], crown_node[{k + 1, j1}], j * dth, crown_z(k, j), (j + 1) * dth,
-               crown_z(k + 1, j1),
+      add_line(crown_node[{k, j}], crown_node[{k + 1, j1}], j * dth, crown_z(k, j), (j + 1) * dth, crown_z(k + 1, j1),
                p.elements_per_connector, 1, m.num_connectors++);
     }
   // fixation: 4 bottom crowns of a ring, 90° apart (middle ring; every ring)
@@ -105,8 +101,10 @@ StentMesh generate(const StentParameters& p, const geometry::Centerline* centerl
   ring_nodes(p.rings / 2, m.fixation_nodes);
   for (int k = 0; k < p.rings; ++k) ring_nodes(k, m.ring_fixation_nodes);
   for (int j = 0; j < nc; ++j) {
-    if (j % 2 == 0) m.distal_nodes.push_back(crown_node[{0, j}]);
-    else if (p.rings > 1) m.distal_nodes.push_back(crown_node[{p.rings - 1, j}]);
+    if (j % 2 == 0)
+      m.distal_nodes.push_back(crown_node[{0, j}]);
+    else if (p.rings > 1)
+      m.distal_nodes.push_back(crown_node[{p.rings - 1, j}]);
     m.central_nodes.push_back(crown_node[{(p.rings - 1) / 2, j}]);
     if (p.rings % 2 == 0) m.central_nodes.push_back(crown_node[{p.rings / 2, j}]);
   }

@@ -7,8 +7,7 @@
 namespace angio::coupler {
 
 Aitken::Aitken(double initial, double maximum)
-    : initial_(initial), maximum_(maximum), omega_(initial), omega_prev_(initial),
-      omega_step_start_(initial) {
+    : initial_(initial), maximum_(maximum), omega_(initial), omega_prev_(initial), omega_step_start_(initial) {
   if (!(initial > 0.0) || !(maximum >= initial))
     throw std::invalid_argument("Aitken: need 0 < initial <= maximum relaxation factor");
 }

@@ -11,8 +11,8 @@ namespace angio::coupler {
 namespace {
 
 std::string newton_failure(const char* who, int k, const participant::SolveStats& s) {
-  return std::string(who) + " Newton failed in coupling iteration " + std::to_string(k) + ": " +
-         s.message + ", residual history " + log::list(s.residual_history);
+  return std::string(who) + " Newton failed in coupling iteration " + std::to_string(k) + ": " + s.message +
+         ", residual history " + log::list(s.residual_history);
 }
 
 // |w r| (N): the coupling residual r (N/mm per sample point, 3 per point) weighted by the arc lengths.
@@ -26,8 +26,8 @@ double weighted_norm(const Eigen::VectorXd& r, const std::vector<double>& w) {
 }  // namespace
 
 RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
-                      const scene::TimeSettings& time, const CouplingSettings& settings,
-                      Acceleration& acc, const StepCallback& on_step) {
+                      const scene::TimeSettings& time, const CouplingSettings& settings, Acceleration& acc,
+                      const StepCallback& on_step) {
   LoadStepper stepper(time);
   RunReport run;
   const auto run_start = Clock::now();
@@ -99,8 +99,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       }
       const auto& reply = rep.contact;
       if (reply.line_loads.size() != n)
-        throw std::runtime_error("solid returned " + std::to_string(reply.line_loads.size()) +
-                                 " line loads for " + std::to_string(n) + " sample points");
+        throw std::runtime_error("solid returned " + std::to_string(reply.line_loads.size()) + " line loads for " +
+                                 std::to_string(n) + " sample points");
       const Eigen::VectorXd r = scheme->force_residual(rep.beam_points, reply);
       if (!r.allFinite()) {
         participant_failed = true;
@@ -116,8 +116,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       solid_tolerance = settings.inexact_solid * r_force;
       rep.residuals.push_back(rn);
       rep.iterations = k + 1;
-      LOG_DEBUG("step " << rep.step << " iteration " << k << ": ||r|| = " << rn << ", ||q~|| = "
-                        << q_norm << ", omega = " << acc.last_factor());
+      LOG_DEBUG("step " << rep.step << " iteration " << k << ": ||r|| = " << rn << ", ||q~|| = " << q_norm
+                        << ", omega = " << acc.last_factor());
       if (rn <= settings.rel_tol * q_norm + settings.abs_tol * sqrt_len) {
         converged = true;
         break;
@@ -126,8 +126,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       // against the map (IQN-ILS columns from another contact state): drop it and restart from
       // the current iterate (columns of earlier steps too) instead of following it to max_iterations.
       if (settings.restart_growth > 0.0 && rn > settings.restart_growth * smallest) {
-        LOG_DEBUG("step " << rep.step << " iteration " << k << ": residual " << rn << " > "
-                          << settings.restart_growth << " x " << smallest << ", acceleration restarted");
+        LOG_DEBUG("step " << rep.step << " iteration " << k << ": residual " << rn << " > " << settings.restart_growth
+                          << " x " << smallest << ", acceleration restarted");
         acc.restart();
         ++rep.restarts;
         k_restart = k;
@@ -140,8 +140,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
 
     run.beam_time += rep.beam_time;  // every attempt: a rejected one cost its solves too
     run.solid_time += rep.solid_time;
-    const bool accept =
-        converged || (!participant_failed && !settings.strict && rep.iterations > 0);
+    const bool accept = converged || (!participant_failed && !settings.strict && rep.iterations > 0);
     if (!accept && failed_at == 0 && extrapolate) {
       LOG_INFO("step " << rep.step << " t = " << rep.time << " s: " << failure
                        << "; retrying the step from the last accepted interface state (no extrapolation)");
@@ -156,8 +155,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       if (!participant_failed)
         failure = "coupling did not converge in " + std::to_string(settings.max_iterations) +
                   " iterations, residual history " + log::list(rep.residuals);
-      LOG_WARN("step " << rep.step << " t = " << rep.time << " s rejected: " << failure
-                       << "; cutting the step");
+      LOG_WARN("step " << rep.step << " t = " << rep.time << " s rejected: " << failure << "; cutting the step");
       beam.end_step(false);
       solid.end_step(false);
       acc.end_step(false);
@@ -166,9 +164,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       continue;
     }
     if (!converged)
-      LOG_WARN("step " << rep.step << ": coupling not converged after " << rep.iterations
-                       << " iterations (residual " << rep.residuals.back()
-                       << "), accepted because coupling.strict is false");
+      LOG_WARN("step " << rep.step << ": coupling not converged after " << rep.iterations << " iterations (residual "
+                       << rep.residuals.back() << "), accepted because coupling.strict is false");
     rep.converged = converged;
     constant_retry = false;
     first_residual_force = step_first_force;

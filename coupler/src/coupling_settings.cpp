@@ -12,13 +12,13 @@ CouplingSettings coupling_settings(const scene::Node& root) {
     if (auto p = root.optional(part); p && p->is_map() && p->has("initial_state")) s.synchronize = true;
   auto c = root.optional("coupling");
   if (!c) return s;
-  c->check_keys({"scheme", "acceleration", "initial_relaxation", "max_relaxation", "max_iterations",
-                 "rel_tol", "abs_tol", "strict", "restart_growth", "prediction", "record", "iqn", "inexact_solid"});
+  c->check_keys({"scheme", "acceleration", "initial_relaxation", "max_relaxation", "max_iterations", "rel_tol",
+                 "abs_tol", "strict", "restart_growth", "prediction", "record", "iqn", "inexact_solid"});
   s.scheme = c->choice_or("scheme", {"dirichlet-neumann", "robin"}, s.scheme);
   s.acceleration = c->choice_or("acceleration", {"aitken", "iqn-ils", "constant"}, s.acceleration);
   if (c->has("initial_relaxation")) s.initial_relaxation = c->in_range("initial_relaxation", 1e-6, 2.0);
-  s.max_relaxation = c->has("max_relaxation") ? c->in_range("max_relaxation", 1e-6, 10.0)
-                                              : std::max(1.0, s.initial_relaxation);
+  s.max_relaxation =
+      c->has("max_relaxation") ? c->in_range("max_relaxation", 1e-6, 10.0) : std::max(1.0, s.initial_relaxation);
   if (s.max_relaxation < s.initial_relaxation)
     c->child("max_relaxation").fail("a value >= coupling.initial_relaxation");
   if (auto iqn = c->optional("iqn")) {

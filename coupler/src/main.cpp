@@ -86,9 +86,9 @@ int run(const cli::Parser& args) {
     const std::string beam_sw = beam.hello();
     const std::string solid_sw = solid.hello();
     LOG_INFO("run " << run_id << ": beam " << beam_sw << " (" << beam.sample_points().size()
-                    << " contact sample points), solid " << solid_sw << "; " << time.steps << " steps to t = "
-                    << time.end << " s, " << settings.scheme << " coupling with " << settings.acceleration
-                    << " acceleration");
+                    << " contact sample points), solid " << solid_sw << "; " << time.steps
+                    << " steps to t = " << time.end << " s, " << settings.scheme << " coupling with "
+                    << settings.acceleration << " acceleration");
     report = coupler::run_coupled(beam, solid, time, settings, *acc, [&](const coupler::StepReport& r) {
       const double messaging = beam_ch.messaging_time() + solid_ch.messaging_time();
       const double step_messaging = messaging - messaging_before;
@@ -96,11 +96,10 @@ int run(const cli::Parser& args) {
       const double p = balloon_pressure.at(r.time);
       csv.write(r, p, step_messaging);
       LOG_INFO("step " << r.step << " t = " << r.time << " s p = " << p << " MPa: " << r.iterations
-                       << " coupling iterations, residual "
-                       << (r.residuals.empty() ? 0.0 : r.residuals.back()) << ", omega " << r.omega
-                       << ", " << r.contact.n_active << " active, wall " << std::setprecision(3)
-                       << r.wall_time << " s (beam " << r.beam_time << ", solid " << r.solid_time
-                       << ")");
+                       << " coupling iterations, residual " << (r.residuals.empty() ? 0.0 : r.residuals.back())
+                       << ", omega " << r.omega << ", " << r.contact.n_active << " active, wall "
+                       << std::setprecision(3) << r.wall_time << " s (beam " << r.beam_time << ", solid "
+                       << r.solid_time << ")");
       if (g_stop) throw coupler::StopRequested{};
     });
   } catch (const std::exception& e) {
@@ -135,11 +134,9 @@ int run(const cli::Parser& args) {
     return 130;
   }
   write_summary(run_dir / "coupling_summary.json", "ok", "", report, messaging);
-  LOG_INFO("done: " << report.steps << " steps, coupling iterations mean "
-                    << report.mean_iterations()
-                    << " max " << report.max_iterations << ", wall " << report.wall_time
-                    << " s, messaging " << 100.0 * messaging / std::max(report.wall_time, 1e-12)
-                    << " %");
+  LOG_INFO("done: " << report.steps << " steps, coupling iterations mean " << report.mean_iterations() << " max "
+                    << report.max_iterations << ", wall " << report.wall_time << " s, messaging "
+                    << 100.0 * messaging / std::max(report.wall_time, 1e-12) << " %");
   return 0;
 }
 
@@ -152,11 +149,14 @@ int main(int argc, char** argv) {
                    "to --endpoint.");
   args.add_common();
   args.add({"record", "", "record every exchanged message into <run-dir>/exchanges.angiorec", ""});
-  args.add({"print-settings", "", "print the scene's coupling settings with every default filled in (JSON) and exit", ""});
+  args.add(
+      {"print-settings", "", "print the scene's coupling settings with every default filled in (JSON) and exit", ""});
   return cli::run_main(args, argc, argv, [&] {
     cli::setup_logging(args, "coupler");
-    if (args.has("check") || args.has("print-settings")) cli::require(args, {"scene"});
-    else cli::require(args, {"scene", "endpoint"});
+    if (args.has("check") || args.has("print-settings"))
+      cli::require(args, {"scene"});
+    else
+      cli::require(args, {"scene", "endpoint"});
     return run(args);
   });
 }

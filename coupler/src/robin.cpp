@@ -52,14 +52,13 @@ Eigen::VectorXd Robin::plane_loads(const participant::SamplePoints& x, const Pla
     if (!(p.eps[j] > 0.0)) continue;
     const std::size_t i = std::size_t(j) / K;
     const Eigen::Vector3d xi(x.x[i][0], x.x[i][1], x.x[i][2]);
-    q.segment<3>(3 * i) += participant::plane_penalty(xi, p.s.segment<3>(3 * j), p.n.segment<3>(3 * j), p.eps[j],
-                                                      x.radius[i], p.g0).q;
+    q.segment<3>(3 * i) +=
+        participant::plane_penalty(xi, p.s.segment<3>(3 * j), p.n.segment<3>(3 * j), p.eps[j], x.radius[i], p.g0).q;
   }
   return q;
 }
 
-Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x,
-                                      const participant::ContactReply& reply) {
+Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) {
   const std::size_t n = x.size();
   const std::size_t K = participant::planes_per_point(reply.penalty.size(), n);
   if (K == 0 || reply.surface_points.size() != reply.penalty.size() || reply.normals.size() != reply.penalty.size())

@@ -14,11 +14,10 @@ StepCsv::StepCsv(const std::string& path) : out_(path) {
 }
 
 void StepCsv::write(const StepReport& r, double pressure, double messaging) {
-  out_ << std::setprecision(10) << r.step << ',' << r.time << ',' << pressure << ','
-       << r.iterations << ',' << (r.residuals.empty() ? 0.0 : r.residuals.back()) << ','
-       << r.omega << ',' << r.cuts << ',' << (r.converged ? 1 : 0) << ',' << r.beam_time << ','
-       << r.solid_time << ',' << messaging << ',' << r.wall_time << ',' << r.contact.n_active
-       << ',' << r.contact.min_gap << ',' << r.contact.total_force[0] << ','
+  out_ << std::setprecision(10) << r.step << ',' << r.time << ',' << pressure << ',' << r.iterations << ','
+       << (r.residuals.empty() ? 0.0 : r.residuals.back()) << ',' << r.omega << ',' << r.cuts << ','
+       << (r.converged ? 1 : 0) << ',' << r.beam_time << ',' << r.solid_time << ',' << messaging << ',' << r.wall_time
+       << ',' << r.contact.n_active << ',' << r.contact.min_gap << ',' << r.contact.total_force[0] << ','
        << r.contact.total_force[1] << ',' << r.contact.total_force[2] << ',' << r.restarts << '\n';
   // Flushed per step: a run that fails later leaves every committed step readable.
   out_.flush();

@@ -7,8 +7,8 @@
 
 namespace angio::coupler {
 
-std::string coupling_summary_json(const std::string& status, const std::string& error,
-                                  const RunReport& run, double messaging_time) {
+std::string coupling_summary_json(const std::string& status, const std::string& error, const RunReport& run,
+                                  double messaging_time) {
   using nlohmann::ordered_json;
   auto finite = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr); };
   ordered_json j;
@@ -29,8 +29,8 @@ std::string coupling_summary_json(const std::string& status, const std::string& 
   return j.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n";
 }
 
-bool write_coupling_summary(const std::string& path, const std::string& status,
-                            const std::string& error, const RunReport& run, double messaging_time) {
+bool write_coupling_summary(const std::string& path, const std::string& status, const std::string& error,
+                            const RunReport& run, double messaging_time) {
   std::ofstream o(path);
   if (!o) return false;
   o << coupling_summary_json(status, error, run, messaging_time);

@@ -23,9 +23,9 @@ LAYERS = ("intima", "media", "adventitia")
 
 @dataclass
 class WallSpec:
-    media_ratio: float        # media thickness / outer diameter
-    adventitia_ratio: float   # adventitia thickness / outer diameter
-    min_intima: float         # mm: thinner intima is refused (no elements fit in it)
+    media_ratio: float  # media thickness / outer diameter
+    adventitia_ratio: float  # adventitia thickness / outer diameter
+    min_intima: float  # mm: thinner intima is refused (no elements fit in it)
 
 
 def rotation_minimizing_normals(pts):
@@ -71,12 +71,14 @@ def layer_radii(r, wall, spec, where):
         raise PatientInputError(
             f"{where}: the wall ({wall[k]:.3f} mm at station {k}) is too thin for media ({tm[k]:.3f} mm) and "
             f"adventitia ({ta[k]:.3f} mm) with an intima of at least {spec.min_intima:g} mm: expected a thicker wall "
-            f"or smaller media_ratio/adventitia_ratio")
+            f"or smaller media_ratio/adventitia_ratio"
+        )
     return np.column_stack([r, r + ti, r + ti + tm, r + wall]), ti, tm, ta
 
 
-def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, loft_spacing=0.5,
-                 where="patient", log=print):
+def build_artery(
+    points, radius, wall, spec, mesh_size, out_path, binary=False, loft_spacing=0.5, where="patient", log=print
+):
     """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts."""
     import gmsh
 
@@ -95,8 +97,10 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
             for i in range(len(P)):
                 c = occ.addPoint(*P[i])
                 R = radii[i, layer]
-                q = [occ.addPoint(*(P[i] + R * (math.cos(a) * n1[i] + math.sin(a) * n2[i])))
-                     for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
+                q = [
+                    occ.addPoint(*(P[i] + R * (math.cos(a) * n1[i] + math.sin(a) * n2[i])))
+                    for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)
+                ]
                 arcs = [occ.addCircleArc(q[k], c, q[(k + 1) % 4]) for k in range(4)]
                 wires.append(occ.addWire(arcs))
             vol = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
@@ -148,11 +152,11 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
         gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * mesh_size)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 1)       # Delaunay
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
         gmsh.option.setNumber("Mesh.Optimize", 1)
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.model.mesh.generate(3)
-        gmsh.model.mesh.setOrder(2)                         # tet10 / tri6 on the curved geometry
+        gmsh.model.mesh.setOrder(2)  # tet10 / tri6 on the curved geometry
         if _min_quadratic_jacobian() <= 0.0:
             # a mid-edge node pulled onto the curved boundary can invert a thin element: untangle
             # with gmsh's optimizer, and straighten what it leaves inverted
@@ -163,8 +167,10 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
                 log(f"patient: gmsh's high-order optimization stopped ({' '.join(str(e).split())})")
         straightened = _straighten_inverted()
         if straightened:
-            log(f"patient: {straightened} tet10 straightened (mid-edge nodes at the edge midpoints) to keep "
-                f"every Jacobian positive")
+            log(
+                f"patient: {straightened} tet10 straightened (mid-edge nodes at the edge midpoints) to keep "
+                f"every Jacobian positive"
+            )
         if not _min_quadratic_jacobian() > 0.0:
             raise RuntimeError("gmsh produced an inverted tetrahedron")
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
@@ -174,23 +180,34 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
         types, tags, _ = gmsh.model.mesh.getElements(3)
         n_tets = sum(len(tg) for tg in tags)
         node_tags, _, _ = gmsh.model.mesh.getNodes()
-        per_layer = {name: sum(len(tg) for v in by_layer[name] for tg in gmsh.model.mesh.getElements(3, v)[1])
-                     for name in LAYERS}
-        return {"file": str(out_path), "elements": int(n_tets), "nodes": int(len(node_tags)),
-                "dofs": 3 * int(len(node_tags)), "per_layer": per_layer, "mesh_size": mesh_size,
-                "straightened_tet10": int(straightened), "stations": int(len(P)),
-                "thickness_range": {"intima": [float(ti.min()), float(ti.max())],
-                                    "media": [float(tm.min()), float(tm.max())],
-                                    "adventitia": [float(ta.min()), float(ta.max())],
-                                    "wall": [float(w.min()), float(w.max())]}}
+        per_layer = {
+            name: sum(len(tg) for v in by_layer[name] for tg in gmsh.model.mesh.getElements(3, v)[1]) for name in LAYERS
+        }
+        return {
+            "file": str(out_path),
+            "elements": int(n_tets),
+            "nodes": int(len(node_tags)),
+            "dofs": 3 * int(len(node_tags)),
+            "per_layer": per_layer,
+            "mesh_size": mesh_size,
+            "straightened_tet10": int(straightened),
+            "stations": int(len(P)),
+            "thickness_range": {
+                "intima": [float(ti.min()), float(ti.max())],
+                "media": [float(tm.min()), float(tm.max())],
+                "adventitia": [float(ta.min()), float(ta.max())],
+                "wall": [float(w.min()), float(w.max())],
+            },
+        }
     except RuntimeError as e:  # the checks above: a geometry that does not give three clean layers
         raise PatientInputError(f"{where}: cannot mesh the artery from this centerline: {e}") from e
     except Exception as e:
         if type(e) is not Exception:  # a bug of ours, not gmsh's verdict on the geometry
             raise
         # gmsh's Python API raises a bare Exception when it cannot build or mesh the geometry
-        raise PatientInputError(f"{where}: gmsh cannot mesh the artery from this centerline: "
-                                f"{' '.join(str(e).split())}") from e
+        raise PatientInputError(
+            f"{where}: gmsh cannot mesh the artery from this centerline: " f"{' '.join(str(e).split())}"
+        ) from e
     finally:
         gmsh.finalize()
 
@@ -198,6 +215,7 @@ def build_artery(points, radius, wall, spec, mesh_size, out_path, binary=False, 
 def _min_quadratic_jacobian():
     """Smallest Jacobian determinant of the tet10 elements at their Gauss points (gmsh's own)."""
     import gmsh
+
     lo = math.inf
     types, _, _ = gmsh.model.mesh.getElements(3)
     for et in types:
@@ -216,6 +234,7 @@ def _straighten_inverted(max_rounds=5):
     """Moves the mid-edge nodes of tet10 with a non-positive Jacobian to their edge midpoints (a
     straight-sided tet10 is valid whenever its tet4 is); returns how many elements were changed."""
     import gmsh
+
     changed = set()
     for _ in range(max_rounds):
         pts, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")

@@ -12,7 +12,7 @@ import numpy as np
 
 from .errors import PatientInputError
 
-MAX_BYTES = 64 * 2**20     # a centerline is a few thousand rows; refuse anything that is not one
+MAX_BYTES = 64 * 2**20  # a centerline is a few thousand rows; refuse anything that is not one
 MAX_POINTS = 200_000
 REQUIRED = ("x", "y", "z", "r")
 OPTIONAL = ("wall",)
@@ -21,9 +21,9 @@ OPTIONAL = ("wall",)
 @dataclass
 class LumenCenterline:
     path: str
-    points: np.ndarray        # (n, 3) mm
-    radius: np.ndarray        # (n,) lumen radius, mm
-    wall: np.ndarray | None   # (n,) total wall thickness, mm (None: not in the file)
+    points: np.ndarray  # (n, 3) mm
+    radius: np.ndarray  # (n,) lumen radius, mm
+    wall: np.ndarray | None  # (n,) total wall thickness, mm (None: not in the file)
 
     @functools.cached_property
     def arc_length(self):
@@ -44,7 +44,9 @@ def read_centerline_csv(path):
     if not os.path.isfile(path):
         raise PatientInputError(f"{path}: expected a centerline CSV file, got a directory or special file")
     if size > MAX_BYTES:
-        raise PatientInputError(f"{path}: expected a centerline CSV of at most {MAX_BYTES // 2**20} MiB, got {size} bytes")
+        raise PatientInputError(
+            f"{path}: expected a centerline CSV of at most {MAX_BYTES // 2**20} MiB, got {size} bytes"
+        )
     try:
         with open(path, newline="", encoding="utf-8") as f:
             lines = [(i + 1, ln) for i, ln in enumerate(f) if ln.strip() and not ln.lstrip().startswith("#")]
@@ -56,11 +58,15 @@ def read_centerline_csv(path):
     cols = [c.strip().lower() for c in next(csv.reader([header]))]
     for c in REQUIRED:
         if c not in cols:
-            raise PatientInputError(f"{path}:{header_line}: expected a header with the columns x,y,z,r "
-                                    f"(and optionally wall), got {','.join(cols)} (no column '{c}')")
+            raise PatientInputError(
+                f"{path}:{header_line}: expected a header with the columns x,y,z,r "
+                f"(and optionally wall), got {','.join(cols)} (no column '{c}')"
+            )
     unknown = [c for c in cols if c not in REQUIRED + OPTIONAL]
     if unknown:
-        raise PatientInputError(f"{path}:{header_line}: unknown column '{unknown[0]}', expected x,y,z,r and optionally wall")
+        raise PatientInputError(
+            f"{path}:{header_line}: unknown column '{unknown[0]}', expected x,y,z,r and optionally wall"
+        )
     if len(set(cols)) != len(cols):
         raise PatientInputError(f"{path}:{header_line}: a column is named twice ({','.join(cols)})")
     rows = lines[1:]
@@ -70,41 +76,57 @@ def read_centerline_csv(path):
     for k, (line_no, text) in enumerate(rows):
         fields = next(csv.reader([text]))
         if len(fields) != len(cols):
-            raise PatientInputError(f"{path}:{line_no}: expected {len(cols)} values ({','.join(cols)}), got {len(fields)}")
+            raise PatientInputError(
+                f"{path}:{line_no}: expected {len(cols)} values ({','.join(cols)}), got {len(fields)}"
+            )
         for j, v in enumerate(fields):
             try:
                 x = float(v)
             except ValueError:
-                raise PatientInputError(f"{path}:{line_no}: column {cols[j]}: expected a number, got {v.strip()!r}") from None
+                raise PatientInputError(
+                    f"{path}:{line_no}: column {cols[j]}: expected a number, got {v.strip()!r}"
+                ) from None
             if not math.isfinite(x):
-                raise PatientInputError(f"{path}:{line_no}: column {cols[j]}: expected a finite number, got {v.strip()}")
+                raise PatientInputError(
+                    f"{path}:{line_no}: column {cols[j]}: expected a finite number, got {v.strip()}"
+                )
             data[k, j] = x
     if len(rows) < 4:
-        raise PatientInputError(f"{path}: expected at least 4 centerline points (a cubic spline needs them), got {len(rows)}")
+        raise PatientInputError(
+            f"{path}: expected at least 4 centerline points (a cubic spline needs them), got {len(rows)}"
+        )
     col = {c: data[:, j] for j, c in enumerate(cols)}
     pts = np.column_stack([col["x"], col["y"], col["z"]])
     r = col["r"]
     for k in range(len(rows)):
         if not r[k] > 0:
-            raise PatientInputError(f"{path}:{rows[k][0]}: column r: expected a positive lumen radius (mm), got {r[k]:g}")
+            raise PatientInputError(
+                f"{path}:{rows[k][0]}: column r: expected a positive lumen radius (mm), got {r[k]:g}"
+            )
     seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     scale = max(float(np.ptp(pts, axis=0).max()), 1e-300)
     for k in np.nonzero(seg <= 1e-9 * scale)[0]:
-        raise PatientInputError(f"{path}:{rows[k + 1][0]}: expected distinct consecutive points, got the point of line "
-                                f"{rows[k][0]} repeated ({pts[k, 0]:g}, {pts[k, 1]:g}, {pts[k, 2]:g})")
+        raise PatientInputError(
+            f"{path}:{rows[k + 1][0]}: expected distinct consecutive points, got the point of line "
+            f"{rows[k][0]} repeated ({pts[k, 0]:g}, {pts[k, 1]:g}, {pts[k, 2]:g})"
+        )
     # a centerline that doubles back is not a vessel: consecutive segments turning by more than 90°
     if len(seg) >= 2:
         t = np.diff(pts, axis=0) / seg[:, None]
         cosang = np.einsum("ij,ij->i", t[:-1], t[1:])
         for k in np.nonzero(cosang < 0)[0]:
-            raise PatientInputError(f"{path}:{rows[k + 1][0]}: expected a centerline without reversals, got a turn of "
-                                    f"{math.degrees(math.acos(max(-1.0, cosang[k]))):.0f}° at this point")
+            raise PatientInputError(
+                f"{path}:{rows[k + 1][0]}: expected a centerline without reversals, got a turn of "
+                f"{math.degrees(math.acos(max(-1.0, cosang[k]))):.0f}° at this point"
+            )
     wall = None
     if "wall" in col:
         wall = col["wall"]
         for k in range(len(rows)):
             if not wall[k] > 0:
-                raise PatientInputError(f"{path}:{rows[k][0]}: column wall: expected a positive wall thickness (mm), got {wall[k]:g}")
+                raise PatientInputError(
+                    f"{path}:{rows[k][0]}: column wall: expected a positive wall thickness (mm), got {wall[k]:g}"
+                )
     return LumenCenterline(path=str(path), points=pts, radius=r, wall=wall)
 
 

@@ -32,49 +32,59 @@ from scipy.interpolate import UnivariateSpline
 from .centerline_csv import arc_length
 from .errors import PatientInputError
 
-FITPACK_TOL = 1e-3   # curfit's fixed tolerance: ε_ζ of eq. (3)
+FITPACK_TOL = 1e-3  # curfit's fixed tolerance: ε_ζ of eq. (3)
 ENDPOINT_WEIGHT = 10.0  # the balloon ends lie on the lumen centerline (paper §2.4)
 
 
 @dataclass
 class Device:
-    balloon_length: float     # mm
-    balloon_radius: float     # outer radius, mm
-    stent_length: float       # mm
-    stent_radius: float       # crimped outer radius (centerline radius + strut radius), mm
+    balloon_length: float  # mm
+    balloon_radius: float  # outer radius, mm
+    stent_length: float  # mm
+    stent_radius: float  # crimped outer radius (centerline radius + strut radius), mm
 
 
 @dataclass
 class Placement:
-    s_site: float                   # lumen arc length of the stenosis site
+    s_site: float  # lumen arc length of the stenosis site
     site_point: np.ndarray
     site_radius: float
     s0: float
-    s1: float                       # lumen arc lengths of the balloon end points
-    points: np.ndarray              # device centerline polyline (extended beyond the balloon ends)
-    sigma_site: float               # its arc length at the site
-    balloon_start: float            # arc length on the device centerline where the balloon starts
+    s1: float  # lumen arc lengths of the balloon end points
+    points: np.ndarray  # device centerline polyline (extended beyond the balloon ends)
+    sigma_site: float  # its arc length at the site
+    balloon_start: float  # arc length on the device centerline where the balloon starts
     stent_start: float
-    clearance_balloon: float        # min clearance of the balloon surface from the endothelium, mm
+    clearance_balloon: float  # min clearance of the balloon surface from the endothelium, mm
     clearance_stent: float
     clearance_where: dict = field(default_factory=dict)
-    axis_clearance: float = float("nan")   # min distance of the device axis from the endothelium, mm
-    insertion: bool = False                # devices placed into a lesion narrower than themselves
-    spline: list = field(default_factory=list)   # per coordinate: knots, residual, condition
+    axis_clearance: float = float("nan")  # min distance of the device axis from the endothelium, mm
+    insertion: bool = False  # devices placed into a lesion narrower than themselves
+    spline: list = field(default_factory=list)  # per coordinate: knots, residual, condition
     weight_rounds: int = 0
     max_weight: float = 1.0
 
     def report(self):
         return {
-            "stenosis": {"arc_length": self.s_site, "point": self.site_point.tolist(),
-                         "lumen_diameter": 2 * self.site_radius},
+            "stenosis": {
+                "arc_length": self.s_site,
+                "point": self.site_point.tolist(),
+                "lumen_diameter": 2 * self.site_radius,
+            },
             "balloon_ends_lumen_arc_length": [self.s0, self.s1],
             "device_centerline_length": float(arc_length(self.points)[-1]),
-            "balloon_start": self.balloon_start, "stent_start": self.stent_start,
-            "clearance": {"balloon": self.clearance_balloon, "stent": self.clearance_stent,
-                          "axis": self.axis_clearance, **self.clearance_where},
+            "balloon_start": self.balloon_start,
+            "stent_start": self.stent_start,
+            "clearance": {
+                "balloon": self.clearance_balloon,
+                "stent": self.clearance_stent,
+                "axis": self.axis_clearance,
+                **self.clearance_where,
+            },
             "insertion": self.insertion,
-            "spline": self.spline, "weight_rounds": self.weight_rounds, "max_weight": self.max_weight,
+            "spline": self.spline,
+            "weight_rounds": self.weight_rounds,
+            "max_weight": self.max_weight,
         }
 
 
@@ -111,8 +121,9 @@ def stenosis_site(cl, s_given=None, where="patient.stenosis"):
         i = int(np.argmin(cl.radius))
         return float(s[i])
     if not (0.0 <= s_given <= s[-1]):
-        raise PatientInputError(f"{where}: expected an arc length within the centerline (0 .. {s[-1]:.3f} mm), "
-                                f"got {s_given:g}")
+        raise PatientInputError(
+            f"{where}: expected an arc length within the centerline (0 .. {s[-1]:.3f} mm), " f"got {s_given:g}"
+        )
     return float(s_given)
 
 
@@ -132,8 +143,7 @@ def devices_fit(cl, dev, s_site, margin=0.0):
     return rmin["stent"] >= dev.stent_radius + margin and rmin["balloon"] >= dev.balloon_radius + margin
 
 
-def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.05, extension=None,
-                 insertion=False):
+def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.05, extension=None, insertion=False):
     """Balloon centerline and device positions (see the module comment). PatientInputError when the
     balloon does not fit on the centerline or the devices cannot clear the endothelium (with
     `insertion`: when the axis cannot be kept inside the lumen)."""
@@ -145,10 +155,13 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
         raise PatientInputError(
             f"{src}: the balloon ({dev.balloon_length:g} mm) centred at the stenosis (arc length {s_site:.2f} mm) "
             f"reaches beyond the centerline (0 .. {L:.2f} mm): expected a centerline reaching at least "
-            f"{0.5 * dev.balloon_length:g} mm on each side of the site, or a shorter balloon")
+            f"{0.5 * dev.balloon_length:g} mm on each side of the site, or a shorter balloon"
+        )
     if dev.stent_length > dev.balloon_length:
-        raise PatientInputError(f"stent: the stent ({dev.stent_length:g} mm) is longer than the balloon "
-                                f"({dev.balloon_length:g} mm): expected a stent that fits on the balloon")
+        raise PatientInputError(
+            f"stent: the stent ({dev.stent_length:g} mm) is longer than the balloon "
+            f"({dev.balloon_length:g} mm): expected a stent that fits on the balloon"
+        )
     # the devices must fit in the lumen at all (the narrowest station under each device), unless a
     # virtual insertion opens the lesion first
     narrowest = narrowest_under(cl, dev, s_site)
@@ -157,9 +170,11 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
         if rmin < R + margin and not insertion:
             raise PatientInputError(
                 f"{src}: the crimped {name} (outer diameter {2 * R:.3f} mm) does not fit in the lumen "
-                f"(narrowest diameter {2 * rmin:.3f} mm under the {name}{f', margin {margin:g} mm' if margin else ''}): "
+                f"(narrowest diameter {2 * rmin:.3f} mm under the {name}"
+                f"{f', margin {margin:g} mm' if margin else ''}): "
                 f"expected a lumen wider than the device, a smaller {name}, or the virtual insertion "
-                f"(patient.insertion.mode: auto)")
+                f"(patient.insertion.mode: auto)"
+            )
 
     inside = (s > s0) & (s < s1)
     p0, _ = lumen_at(cl.points, cl.radius, s, s0)
@@ -167,8 +182,10 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
     x = np.concatenate([[s0], s[inside], [s1]])
     y = np.vstack([p0, cl.points[inside], p1])
     if len(x) < 4:
-        raise PatientInputError(f"{src}: expected at least 2 centerline points within the balloon "
-                                f"(arc length {s0:.2f} .. {s1:.2f} mm) for the cubic spline, got {len(x) - 2}")
+        raise PatientInputError(
+            f"{src}: expected at least 2 centerline points within the balloon "
+            f"(arc length {s0:.2f} .. {s1:.2f} mm) for the cubic spline, got {len(x) - 2}"
+        )
     w = np.ones(len(x))
     w[0] = w[-1] = ENDPOINT_WEIGHT
     xs = np.linspace(s0, s1, max(int(math.ceil((s1 - s0) / sample)) + 1, 8))
@@ -190,9 +207,16 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
             k = int(np.argmin(clear))
             raise PatientInputError(
                 f"{src}: cannot place the balloon centerline without "
-                f"{'its axis coming within ' + format(margin, '.3f') + ' mm of' if insertion else 'the devices overlapping'} the endothelium "
-                f"(after {rounds} rounds of weight adaptation, {-clear[k] + margin:.3f} mm too close at lumen arc length "
-                f"{xs[k]:.2f} mm, lumen diameter {2 * r[k]:.3f} mm there): expected a wider lumen or smaller devices")
+                + (
+                    "its axis coming within " + format(margin, ".3f") + " mm of"
+                    if insertion
+                    else "the devices overlapping"
+                )
+                + " the endothelium "
+                f"(after {rounds} rounds of weight adaptation, {-clear[k] + margin:.3f} mm too close at lumen "
+                f"arc length "
+                f"{xs[k]:.2f} mm, lumen diameter {2 * r[k]:.3f} mm there): expected a wider lumen or smaller devices"
+            )
         # double the weights of the lumen points near the stations that come too close
         bad = xs[clear < margin]
         near = np.min(np.abs(x[:, None] - bad[None, :]), axis=1) <= max(2 * sample, 0.5)
@@ -204,14 +228,23 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
         fp = float(sp.get_residual())
         n_int = len(sp.get_knots()) - 2
         cond = abs(fp - zeta) < FITPACK_TOL * zeta
-        spline_info.append({"coordinate": "xyz"[c], "interior_knots": n_int, "residual": fp,
-                            "zeta": zeta, "eq3_equality": bool(cond),
-                            "case": "eq. (3) holds" if cond else
-                            ("least-squares cubic, residual below zeta" if fp < zeta and n_int == 0 else
-                             "eq. (3) not met")})
+        spline_info.append(
+            {
+                "coordinate": "xyz"[c],
+                "interior_knots": n_int,
+                "residual": fp,
+                "zeta": zeta,
+                "eq3_equality": bool(cond),
+                "case": "eq. (3) holds"
+                if cond
+                else ("least-squares cubic, residual below zeta" if fp < zeta and n_int == 0 else "eq. (3) not met"),
+            }
+        )
         if not cond and not (fp < zeta and n_int == 0):
-            raise PatientInputError(f"{src}: the smoothing spline ({'xyz'[c]}) did not meet eq. (3): "
-                                    f"residual {fp:.4g} against zeta {zeta:g} (FITPACK gave up; too few points?)")
+            raise PatientInputError(
+                f"{src}: the smoothing spline ({'xyz'[c]}) did not meet eq. (3): "
+                f"residual {fp:.4g} against zeta {zeta:g} (FITPACK gave up; too few points?)"
+            )
 
     # the device centerline: the spline between the balloon ends, extended along the end tangents so
     # that the balloon (as long as the lumen arc, the spline is shorter) and the springs fit on it
@@ -228,7 +261,7 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
     full = np.vstack([head, pts, tail])
     sig = arc_length(full)
     # the site on the device centerline: its arc length at the spline parameter s_site
-    sig_site = float(np.interp(s_site, xs, sig[n_ext:n_ext + len(xs)]))
+    sig_site = float(np.interp(s_site, xs, sig[n_ext : n_ext + len(xs)]))
     b_start = sig_site - 0.5 * dev.balloon_length
     st_start = sig_site - 0.5 * dev.stent_length
     if b_start < 0 or sig_site + 0.5 * dev.balloon_length > sig[-1]:
@@ -240,10 +273,24 @@ def place_device(cl, dev, s_site, zeta=4.0, margin=0.0, max_rounds=40, sample=0.
     ks = int(np.argmin(cs))
     site_point, site_radius = lumen_at(cl.points, cl.radius, s, s_site)
     return Placement(
-        s_site=s_site, site_point=site_point, site_radius=site_radius, s0=s0, s1=s1, points=full,
-        sigma_site=sig_site, balloon_start=b_start, stent_start=st_start,
-        clearance_balloon=float(cb[kb]), clearance_stent=float(cs[ks]) if stent_zone.any() else float("nan"),
-        clearance_where={"balloon_min_at_lumen_arc_length": float(xs[kb]),
-                         "stent_min_at_lumen_arc_length": float(xs[ks])},
-        spline=spline_info, weight_rounds=rounds, max_weight=float(w[1:-1].max()) if len(w) > 2 else 1.0,
-        axis_clearance=float((r - dist).min()), insertion=bool(insertion))
+        s_site=s_site,
+        site_point=site_point,
+        site_radius=site_radius,
+        s0=s0,
+        s1=s1,
+        points=full,
+        sigma_site=sig_site,
+        balloon_start=b_start,
+        stent_start=st_start,
+        clearance_balloon=float(cb[kb]),
+        clearance_stent=float(cs[ks]) if stent_zone.any() else float("nan"),
+        clearance_where={
+            "balloon_min_at_lumen_arc_length": float(xs[kb]),
+            "stent_min_at_lumen_arc_length": float(xs[ks]),
+        },
+        spline=spline_info,
+        weight_rounds=rounds,
+        max_weight=float(w[1:-1].max()) if len(w) > 2 else 1.0,
+        axis_clearance=float((r - dist).min()),
+        insertion=bool(insertion),
+    )

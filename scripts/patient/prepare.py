@@ -34,10 +34,13 @@ KEYS = {
     "balloon_spline": ("map", {}),
     "insertion": ("map", {}),
 }
-WALL_KEYS = {"thickness": ("from_centerline_or_number", "from_centerline"),
-             # thickness / outer diameter; see docs/user-guide.md "Patient-specific arteries" for the source
-             "media_ratio": ("fraction", 0.06), "adventitia_ratio": ("fraction", 0.065),
-             "min_intima": ("positive", 0.05)}
+WALL_KEYS = {
+    "thickness": ("from_centerline_or_number", "from_centerline"),
+    # thickness / outer diameter; see docs/user-guide.md "Patient-specific arteries" for the source
+    "media_ratio": ("fraction", 0.06),
+    "adventitia_ratio": ("fraction", 0.065),
+    "min_intima": ("positive", 0.05),
+}
 MESH_KEYS = {"size": ("positive", 0.8), "binary": ("bool", True), "loft_spacing": ("positive", 0.5)}
 SPLINE_KEYS = {"smoothing": ("positive", 4.0), "clearance": ("non_negative", 0.0)}
 # A lesion narrower than a crimped device: a rigid capsule along the balloon axis (contact.insertion)
@@ -115,11 +118,15 @@ def _absolute_files(node, base):
 
 def device_of(scene, scene_path):
     """Balloon and crimped-stent dimensions from the scene's balloon.mesh and stent sections."""
-    bm = _section(scene, ["balloon", "mesh"], scene_path, "the balloon tube {generator: tube, length, outer_diameter, ...}")
+    bm = _section(
+        scene, ["balloon", "mesh"], scene_path, "the balloon tube {generator: tube, length, outer_diameter, ...}"
+    )
     for k in ("center", "centerline", "start", "file"):
         if k in bm:
-            raise PatientInputError(f"{scene_path}: balloon.mesh.{k}: expected none with a `patient:` section "
-                                    f"(the balloon is placed on the fitted centerline, paper §2.4)")
+            raise PatientInputError(
+                f"{scene_path}: balloon.mesh.{k}: expected none with a `patient:` section "
+                f"(the balloon is placed on the fitted centerline, paper §2.4)"
+            )
     for k in ("length", "outer_diameter"):
         v = bm.get(k)
         if not (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0):
@@ -127,8 +134,10 @@ def device_of(scene, scene_path):
     g = _section(scene, ["stent", "generator"], scene_path, "a stent generator {type: corrugated_rings, ...}")
     for k in ("centerline", "start"):
         if k in g:
-            raise PatientInputError(f"{scene_path}: stent.generator.{k}: expected none with a `patient:` section "
-                                    f"(the stent is placed at the stenosis on the balloon centerline)")
+            raise PatientInputError(
+                f"{scene_path}: stent.generator.{k}: expected none with a `patient:` section "
+                f"(the stent is placed at the stenosis on the balloon centerline)"
+            )
     # the generator's defaults (beam_solver StentParameters) for keys the scene leaves out
     rings = g.get("rings", 6)
     pitch = g.get("ring_pitch", 1.5)
@@ -139,8 +148,12 @@ def device_of(scene, scene_path):
         if not (isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0):
             raise PatientInputError(f"{scene_path}: stent.generator.{k}: expected a positive number, got {v!r}")
     stent_length = (rings - 1) * pitch + height
-    return Device(balloon_length=float(bm["length"]), balloon_radius=0.5 * float(bm["outer_diameter"]),
-                  stent_length=float(stent_length), stent_radius=0.5 * float(crimped) + float(sec))
+    return Device(
+        balloon_length=float(bm["length"]),
+        balloon_radius=0.5 * float(bm["outer_diameter"]),
+        stent_length=float(stent_length),
+        stent_radius=0.5 * float(crimped) + float(sec),
+    )
 
 
 def _curve_value(points, t):
@@ -154,24 +167,32 @@ def add_insertion(done, plc, dev, ins, scene_path):
     radius curve, contact.insertion and the artery contacts' switch-on time. Returns its report."""
     time = done.get("time") if isinstance(done.get("time"), dict) else {}
     start, end = time.get("start", 0.0), time.get("end")
-    tight = (f"the lesion (axis {plc.axis_clearance:.3f} mm from the endothelium at the narrowest) is narrower "
-             f"than the crimped devices (outer radius {max(dev.stent_radius, dev.balloon_radius):.3f} mm)")
+    tight = (
+        f"the lesion (axis {plc.axis_clearance:.3f} mm from the endothelium at the narrowest) is narrower "
+        f"than the crimped devices (outer radius {max(dev.stent_radius, dev.balloon_radius):.3f} mm)"
+    )
     if not (isinstance(start, (int, float)) and start < 0):
-        raise PatientInputError(f"{scene_path}: time.start: expected a phase before the inflation (time.start < 0 s, "
-                                f"e.g. -0.2) in which the virtual insertion tool opens the lumen: {tight}")
+        raise PatientInputError(
+            f"{scene_path}: time.start: expected a phase before the inflation (time.start < 0 s, "
+            f"e.g. -0.2) in which the virtual insertion tool opens the lumen: {tight}"
+        )
     curves = done.get("load_curves") or {}
     bp = done.get("balloon", {}).get("pressure", {})
     bcurve = curves.get(bp.get("curve")) if isinstance(bp, dict) else None
     probe = [start, 0.0] + [float(q[0]) for q in (bcurve or []) if start < float(q[0]) < 0.0]
     if bcurve and any(abs(_curve_value(bcurve, t)) > 0 for t in probe):
-        raise PatientInputError(f"{scene_path}: load_curves.{bp.get('curve')}: expected no balloon pressure before "
-                                f"t = 0 (the virtual insertion opens the lumen then): {tight}")
+        raise PatientInputError(
+            f"{scene_path}: load_curves.{bp.get('curve')}: expected no balloon pressure before "
+            f"t = 0 (the virtual insertion opens the lumen then): {tight}"
+        )
     contact = done.setdefault("contact", {})
     if "insertion" in contact:  # the scene's own tool
         return {"tool": "the scene's contact.insertion"}
     if INSERTION_CURVE in curves:
-        raise PatientInputError(f"{scene_path}: load_curves.{INSERTION_CURVE}: expected no curve of this name "
-                                f"(the patient pipeline writes the insertion tool's radius under it)")
+        raise PatientInputError(
+            f"{scene_path}: load_curves.{INSERTION_CURVE}: expected no curve of this name "
+            f"(the patient pipeline writes the insertion tool's radius under it)"
+        )
     r0 = 0.9 * plc.axis_clearance  # inside the lumen everywhere along the axis
     r_open = max(dev.stent_radius, dev.balloon_radius) + ins["clearance"]
     T = -float(start)
@@ -181,8 +202,11 @@ def add_insertion(done, plc, dev, ins, scene_path):
         pts.append([float(end), 0.0])
     curves[INSERTION_CURVE] = [[round(t, 9), round(v, 9)] for t, v in pts]
     done["load_curves"] = curves
-    contact["insertion"] = {"axis": "balloon", "radius": {"value": 1.0, "curve": INSERTION_CURVE},
-                            "penalty": ins["penalty"]}
+    contact["insertion"] = {
+        "axis": "balloon",
+        "radius": {"value": 1.0, "curve": INSERTION_CURVE},
+        "penalty": ins["penalty"],
+    }
     on = {}
     for key in ("stent_artery", "balloon_artery"):
         c = contact.get(key)
@@ -212,34 +236,45 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     if not isinstance(artery, dict):
         raise PatientInputError(f"{scene_path}: artery: expected a map, got {artery!r}")
     if "mesh" in artery:
-        raise PatientInputError(f"{scene_path}: artery.mesh: expected none with a `patient:` section "
-                                f"(the artery is meshed from patient.centerline)")
+        raise PatientInputError(
+            f"{scene_path}: artery.mesh: expected none with a `patient:` section "
+            f"(the artery is meshed from patient.centerline)"
+        )
     dev = device_of(scene, scene_path)
 
     csv_path = (scene_path.parent / pat["centerline"]).resolve()
     cl = read_centerline_csv(csv_path)
     if wall["thickness"] == "from_centerline":
         if cl.wall is None:
-            raise PatientInputError(f"{scene_path}: patient.wall.thickness: expected a number (mm), as {csv_path} "
-                                    f"has no `wall` column (or add the column)")
+            raise PatientInputError(
+                f"{scene_path}: patient.wall.thickness: expected a number (mm), as {csv_path} "
+                f"has no `wall` column (or add the column)"
+            )
         wall_t = cl.wall
     else:
         wall_t = np.full(len(cl.radius), float(wall["thickness"]))
-    s_site = stenosis_site(cl, None if pat["stenosis"] == "auto" else float(pat["stenosis"]),
-                           where=f"{scene_path}: patient.stenosis")
+    s_site = stenosis_site(
+        cl, None if pat["stenosis"] == "auto" else float(pat["stenosis"]), where=f"{scene_path}: patient.stenosis"
+    )
     insertion = ins["mode"] == "auto" and not devices_fit(cl, dev, s_site, margin=spl["clearance"])
     plc = place_device(cl, dev, s_site, zeta=spl["smoothing"], margin=spl["clearance"], insertion=insertion)
     out = Path(out_dir)
     dev_file = out / "device_centerline.txt"
     lumen_file = out / "lumen_centerline.txt"
-    spec = WallSpec(media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"],
-                    min_intima=wall["min_intima"])
+    spec = WallSpec(
+        media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"], min_intima=wall["min_intima"]
+    )
     msh = out / "artery.msh"
     done = copy.deepcopy(scene)
     del done["patient"]
     _absolute_files(done, scene_path.parent)
-    done["artery"]["mesh"] = {"file": str(msh), "inner": "endothelium", "outer": "outer", "ends": ["end0", "end1"],
-                              "centerline": {"file": str(lumen_file)}}
+    done["artery"]["mesh"] = {
+        "file": str(msh),
+        "inner": "endothelium",
+        "outer": "outer",
+        "ends": ["end0", "end1"],
+        "centerline": {"file": str(lumen_file)},
+    }
     done["balloon"]["mesh"]["centerline"] = {"file": str(dev_file)}
     done["balloon"]["mesh"]["start"] = round(plc.balloon_start, 9)
     done["stent"]["generator"]["centerline"] = {"file": str(dev_file)}
@@ -252,28 +287,54 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         _, ti, _, _ = layer_radii(cl.radius, wall_t, spec, str(csv_path))
         k = int(np.argmin(np.abs(cl.arc_length - s_site)))
         if mesh["size"] > ti[k]:
-            log(f"patient: warning: patient.mesh.size {mesh['size']:g} mm is larger than the intima at the lesion "
+            log(
+                f"patient: warning: patient.mesh.size {mesh['size']:g} mm is larger than the intima at the lesion "
                 f"({ti[k]:.3f} mm) that the virtual insertion stretches: elements may invert while it opens the "
-                f"lumen; a size below {ti[k]:.2f} mm is safer")
+                f"lumen; a size below {ti[k]:.2f} mm is safer"
+            )
     out.mkdir(parents=True, exist_ok=True)
     _write_points(dev_file, plc.points, f"Balloon and stent centerline fitted to {csv_path} (paper §2.4), x y z mm")
     _write_points(lumen_file, cl.points, f"Lumen centerline of {csv_path}, x y z mm (fiber frames)")
     shutil.copyfile(csv_path, out / "lumen.csv")  # the input as it was (radii for the report)
-    fit = ("the crimped devices overlap the wall by up to "
-           f"{-min(plc.clearance_balloon, plc.clearance_stent):.3f} mm: a virtual insertion opens the lumen first"
-           if insertion else f"balloon clears the endothelium by {plc.clearance_balloon:.3f} mm, the crimped stent by "
-                             f"{plc.clearance_stent:.3f} mm")
-    log(f"patient: stenosis at {s_site:.2f} mm (lumen diameter {2 * plc.site_radius:.3f} mm); {fit}; meshing "
-        f"the artery (size {mesh['size']:g} mm)")
-    info = build_artery(cl.points, cl.radius, wall_t, spec, mesh["size"], msh, binary=mesh["binary"],
-                        loft_spacing=mesh["loft_spacing"], where=str(csv_path), log=log)
+    fit = (
+        "the crimped devices overlap the wall by up to "
+        f"{-min(plc.clearance_balloon, plc.clearance_stent):.3f} mm: a virtual insertion opens the lumen first"
+        if insertion
+        else f"balloon clears the endothelium by {plc.clearance_balloon:.3f} mm, the crimped stent by "
+        f"{plc.clearance_stent:.3f} mm"
+    )
+    log(
+        f"patient: stenosis at {s_site:.2f} mm (lumen diameter {2 * plc.site_radius:.3f} mm); {fit}; meshing "
+        f"the artery (size {mesh['size']:g} mm)"
+    )
+    info = build_artery(
+        cl.points,
+        cl.radius,
+        wall_t,
+        spec,
+        mesh["size"],
+        msh,
+        binary=mesh["binary"],
+        loft_spacing=mesh["loft_spacing"],
+        where=str(csv_path),
+        log=log,
+    )
     log(f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs)")
-    report = {"centerline": str(csv_path), "points": int(len(cl.radius)),
-              "lumen_length": float(cl.arc_length[-1]),
-              "lumen_diameter_range": [float(2 * cl.radius.min()), float(2 * cl.radius.max())],
-              "placement": plc.report(), "insertion": ins_report, "artery_mesh": info,
-              "device": {"balloon_length": dev.balloon_length, "balloon_outer_diameter": 2 * dev.balloon_radius,
-                         "stent_length": dev.stent_length, "stent_crimped_outer_diameter": 2 * dev.stent_radius}}
+    report = {
+        "centerline": str(csv_path),
+        "points": int(len(cl.radius)),
+        "lumen_length": float(cl.arc_length[-1]),
+        "lumen_diameter_range": [float(2 * cl.radius.min()), float(2 * cl.radius.max())],
+        "placement": plc.report(),
+        "insertion": ins_report,
+        "artery_mesh": info,
+        "device": {
+            "balloon_length": dev.balloon_length,
+            "balloon_outer_diameter": 2 * dev.balloon_radius,
+            "stent_length": dev.stent_length,
+            "stent_crimped_outer_diameter": 2 * dev.stent_radius,
+        },
+    }
     with open(out / "placement.json", "w") as f:
         json.dump(report, f, indent=2)
     return done, report
@@ -281,6 +342,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
 
 def main(argv=None):
     import yaml
+
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) != 2:
         print(__doc__.strip().splitlines()[-1], file=sys.stderr)

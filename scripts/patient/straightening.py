@@ -24,8 +24,11 @@ def bow(end0, middle, end1):
     chord = float(np.linalg.norm(end1 - end0))
     cross = float(np.linalg.norm(np.cross(a, c)))
     sagitta = cross / chord if chord > 0 else float(np.linalg.norm(a))
-    radius = (float(np.linalg.norm(a) * np.linalg.norm(c)) * chord / (2 * cross)
-              if cross > 1e-12 * np.linalg.norm(a) * np.linalg.norm(c) else float("inf"))
+    radius = (
+        float(np.linalg.norm(a) * np.linalg.norm(c)) * chord / (2 * cross)
+        if cross > 1e-12 * np.linalg.norm(a) * np.linalg.norm(c)
+        else float("inf")
+    )
     return {"sagitta": sagitta, "radius": radius, "chord": chord}
 
 
@@ -33,6 +36,7 @@ def artery_axis_bow(run_dir, times):
     """{label: {time, sagitta, radius, chord}} for the reference and the h5 steps nearest to each of
     `times` ({label: t}); None when the run is not a patient run or lacks the files."""
     import h5py
+
     run = Path(run_dir)
     geo = run / "geometry"
     try:

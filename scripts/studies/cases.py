@@ -34,10 +34,15 @@ def prepare_out_dir(study, out_dir):
             raise StudyError(f"{path}: cannot read the study kept there: {e}")
         if old != ident:
             what = [k for k in ident if (old or {}).get(k) != ident[k]]
-            raise StudyError(f"{study.where}: {out_dir} holds another study (its {', '.join(what) or 'identity'} "
-                             "differs): pass another --out-dir, or remove that directory")
-    doc = {"identity": ident, "study": study.path,
-           "cases": [{"index": c.index, "key": c.key, "params": c.params} for c in study.cases]}
+            raise StudyError(
+                f"{study.where}: {out_dir} holds another study (its {', '.join(what) or 'identity'} "
+                "differs): pass another --out-dir, or remove that directory"
+            )
+    doc = {
+        "identity": ident,
+        "study": study.path,
+        "cases": [{"index": c.index, "key": c.key, "params": c.params} for c in study.cases],
+    }
     write_json(path, doc)
 
 
@@ -105,18 +110,33 @@ def run_case(study, case, out_dir, build_dir, quiet=True):
     try:
         run_dir = os.path.join(d, "run")
         shutil.rmtree(run_dir, ignore_errors=True)  # a retried case starts afresh
-        info = {"state": "running", "index": case.index, "key": case.key, "params": case.params,
-                "host": socket.gethostname(), "started": time.strftime("%Y-%m-%dT%H:%M:%S"),
-                "slurm_job": slurm_task_id()}
+        info = {
+            "state": "running",
+            "index": case.index,
+            "key": case.key,
+            "params": case.params,
+            "host": socket.gethostname(),
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S"),
+            "slurm_job": slurm_task_id(),
+        }
         write_json(os.path.join(d, "case.json"), info)
         log_path = os.path.join(d, "launch.log")
         t0 = time.time()
-        with variant_scene(study.base_path, case.scene, f"study_{case.key}",
-                           f"case {case.key} of study {study.name} (scripts/study.py)") as path:
+        with variant_scene(
+            study.base_path,
+            case.scene,
+            f"study_{case.key}",
+            f"case {case.key} of study {study.name} (scripts/study.py)",
+        ) as path:
             with open(log_path, "w") as log:
                 rc = subprocess.call(launch_command(path, run_dir, build_dir), stdout=log, stderr=subprocess.STDOUT)
-        info.update(state="done" if rc == 0 else "failed", exit_code=rc, wall_s=round(time.time() - t0, 3),
-                    finished=time.strftime("%Y-%m-%dT%H:%M:%S"), message="" if rc == 0 else last_error(log_path))
+        info.update(
+            state="done" if rc == 0 else "failed",
+            exit_code=rc,
+            wall_s=round(time.time() - t0, 3),
+            finished=time.strftime("%Y-%m-%dT%H:%M:%S"),
+            message="" if rc == 0 else last_error(log_path),
+        )
         write_json(os.path.join(d, "case.json"), info)
         return info
     finally:

@@ -30,7 +30,11 @@ def run_local(study, cases, out_dir, build_dir, jobs):
             case, info = fut.result()
             results[case.key] = info
             wall = info.get("wall_s")
-            print(f"[study] {k}/{n} case {case.index} ({case.key}): {info['state']}"
-                  + (f" in {wall:.1f} s" if wall is not None else "")
-                  + (f": {info['message']}" if info.get("message") else ""), file=sys.stderr, flush=True)
+            print(
+                f"[study] {k}/{n} case {case.index} ({case.key}): {info['state']}"
+                + (f" in {wall:.1f} s" if wall is not None else "")
+                + (f": {info['message']}" if info.get("message") else ""),
+                file=sys.stderr,
+                flush=True,
+            )
     return results

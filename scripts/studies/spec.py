@@ -116,8 +116,9 @@ class Study:
             raise StudyError(f"{self.where}: cases: expected a non-empty list of maps (dotted key path: value)")
         for i, c in enumerate(cases):
             if not isinstance(c, dict) or not c:
-                raise StudyError(f"{self.where}: cases[{i}]: expected a non-empty map of dotted key paths to values, "
-                                 f"got {c!r}")
+                raise StudyError(
+                    f"{self.where}: cases[{i}]: expected a non-empty map of dotted key paths to values, " f"got {c!r}"
+                )
         return cases
 
     def _patients(self, patients, here):
@@ -183,8 +184,10 @@ class Study:
             for i, extra in enumerate(listed if listed is not None else [{}]):
                 clash = set(g) & set(extra)
                 if clash:
-                    raise StudyError(f"{self.where}: cases[{i}]: {sorted(clash)[0]}: also a grid axis; "
-                                     "give each key path in one of grid and cases")
+                    raise StudyError(
+                        f"{self.where}: cases[{i}]: {sorted(clash)[0]}: also a grid axis; "
+                        "give each key path in one of grid and cases"
+                    )
                 for pk in patients or [None]:
                     params = {**g, **extra}
                     if pk is not None:
@@ -201,8 +204,10 @@ class Study:
                 raise StudyError(str(e))
             c = Case(index, params, scene)
             if c.key in seen:
-                raise StudyError(f"{self.where}: cases {seen[c.key]} and {index} are the same case "
-                                 f"({json.dumps(params, sort_keys=True)}): remove the duplicate")
+                raise StudyError(
+                    f"{self.where}: cases {seen[c.key]} and {index} are the same case "
+                    f"({json.dumps(params, sort_keys=True)}): remove the duplicate"
+                )
             seen[c.key] = index
             cases.append(c)
         return cases
@@ -211,9 +216,12 @@ class Study:
     def identity(self):
         """What must not change under a study's finished cases: its name, base scene text and common
         changes (adding grid values or cases keeps the finished ones)."""
-        return {"name": self.name, "base": self.base_path,
-                "base_sha1": hashlib.sha1(self.base_text).hexdigest(),
-                "common": json.loads(json.dumps(self.common, sort_keys=True))}
+        return {
+            "name": self.name,
+            "base": self.base_path,
+            "base_sha1": hashlib.sha1(self.base_text).hexdigest(),
+            "common": json.loads(json.dumps(self.common, sort_keys=True)),
+        }
 
     def parameter_names(self):
         return list(dict.fromkeys(k for c in self.cases for k in c.params))

@@ -32,8 +32,14 @@ def rows_of(study, out_dir):
     rows = []
     for c in study.cases:
         st = case_state(out_dir, c)
-        row = {"case": c.key, "index": c.index, "state": st["state"], "wall_s": st.get("wall_s"),
-               "exit_code": st.get("exit_code"), "message": st.get("message", "")}
+        row = {
+            "case": c.key,
+            "index": c.index,
+            "state": st["state"],
+            "wall_s": st.get("wall_s"),
+            "exit_code": st.get("exit_code"),
+            "message": st.get("message", ""),
+        }
         row.update({k: shown(v) for k, v in c.params.items()})
         if st["state"] == "done":
             row.update(flatten(results_of(out_dir, c)))
@@ -76,8 +82,10 @@ def plot(study, rows, out_dir):
     if not study.plot:
         return []
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     x = study.plot["x"]
     others = [p for p in study.parameter_names() if p != x]
     done = [r for r in rows if r["state"] == "done" and isinstance(r.get(x), (int, float))]

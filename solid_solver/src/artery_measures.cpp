@@ -35,8 +35,7 @@ LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<doub
   // of its nodes from their centroid, which is biased low when a few nodes cover only part of the
   // circumference. Bins hold kMinNodes nodes on average, and sparse ones are dropped below.
   constexpr int kMinNodes = 24;
-  const int n = rings ? int(distinct.size())
-                      : std::max(1, std::min(max_stations, int(nodes.size()) / kMinNodes));
+  const int n = rings ? int(distinct.size()) : std::max(1, std::min(max_stations, int(nodes.size()) / kMinNodes));
   groups_.assign(n, {});
   std::vector<double> sum(n, 0.0);
   for (size_t i = 0; i < nodes.size(); ++i) {

@@ -77,25 +77,27 @@ ContactSpec read_contact_spec(const Node& root) {
     spec.balloon_artery.reset();
     return spec;
   }
-  c->check_keys({"stent_balloon", "stent_artery", "balloon_artery", "search_radius", "line_regularization", "line_normals",
-                "log", "insertion"});
+  c->check_keys({"stent_balloon", "stent_artery", "balloon_artery", "search_radius", "line_regularization",
+                 "line_normals", "log", "insertion"});
   spec.search_radius = c->positive_or("search_radius", spec.search_radius);
   spec.line_regularization = c->non_negative_or("line_regularization", spec.line_regularization);
   if (!(spec.line_regularization < 0.5 * spec.search_radius))
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
-  spec.line_averaged_normals = c->choice_or("line_normals", {"closest_point", "averaged"}, "closest_point") == "averaged";
+  spec.line_averaged_normals =
+      c->choice_or("line_normals", {"closest_point", "averaged"}, "closest_point") == "averaged";
   spec.log = c->boolean_or("log", spec.log);
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);
   if (const auto n = c->optional("insertion")) {
-    if (!root.has("artery") && !root.has("patient")) n->fail("no insertion tool without an artery (it opens the lumen)");
+    if (!root.has("artery") && !root.has("patient"))
+      n->fail("no insertion tool without an artery (it opens the lumen)");
     spec.insertion = read_insertion(*n, root);
   }
   if (const auto n = c->optional("balloon_artery")) {
     if (disabled(*n)) {
       spec.balloon_artery.reset();
     } else {
-      n->check_keys({"penalty", "quadrature", "regularization", "two_pass", "from"});
+      n->check_keys({"penalty", "quadrature", "regularization", "two_pass", "slave", "from"});
       auto& o = *spec.balloon_artery;
       o.from = read_from(*n);
       o.penalty = n->positive_or("penalty", o.penalty);
@@ -103,6 +105,11 @@ ContactSpec read_contact_spec(const Node& root) {
       if (o.quadrature > 7) n->child("quadrature").fail("a quadrature degree between 1 and 7");
       o.two_pass = n->boolean_or("two_pass", o.two_pass);
       o.regularization = n->non_negative_or("regularization", o.regularization);
+      // The side whose Gauss points are projected: seen from the balloon, the lumen is a concave
+      // faceted surface, and the closest face (and with it the contact normal) jumps at the bisector
+      // of two faces; seen from the lumen, the balloon is convex and the closest point moves
+      // continuously over its edges.
+      if (n->choice_or("slave", {"balloon", "artery"}, "balloon") == "artery") std::swap(o.slave, o.master);
       if (!(o.regularization < 0.5 * spec.search_radius))
         n->child("regularization").fail("a value below half of contact.search_radius (mm)");
     }
@@ -135,7 +142,8 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   if (spec.insertion && has_artery) {
     InsertionTool::Options io;
     io.axis = spec.insertion->balloon_axis ? runner.scene().balloon_spine : spec.insertion->axis;
-    if (io.axis.size() < 2) throw std::runtime_error("contact.insertion.axis: balloon: the balloon has no axis (a mesh file without one?)");
+    if (io.axis.size() < 2)
+      throw std::runtime_error("contact.insertion.axis: balloon: the balloon has no axis (a mesh file without one?)");
     io.radius = [r = spec.insertion->radius](double t) { return r.at(t); };
     io.penalty = spec.insertion->penalty;
     insertion_ = std::make_unique<InsertionTool>(model, io);
@@ -150,8 +158,8 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
     std::ostringstream os;
     os << std::setprecision(4) << "contact t=" << m.time();
     if (stent_ && stent_->num_points() > 0)
-      os << " stent: " << reply.n_active << "/" << stent_->num_points() << " points active, min gap "
-         << reply.min_gap << " mm, |sum w q| "
+      os << " stent: " << reply.n_active << "/" << stent_->num_points() << " points active, min gap " << reply.min_gap
+         << " mm, |sum w q| "
          << std::sqrt(reply.total_force[0] * reply.total_force[0] + reply.total_force[1] * reply.total_force[1] +
                       reply.total_force[2] * reply.total_force[2])
          << " N;";

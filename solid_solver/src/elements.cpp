@@ -9,9 +9,12 @@ int num_nodes(FaceType t) { return contact::num_nodes(to_contact(t)); }
 int num_corners(FaceType t) { return contact::num_corners(to_contact(t)); }
 const char* name(ElemType t) {
   switch (t) {
-    case ElemType::Hex8: return "hex8";
-    case ElemType::Tet4: return "tet4";
-    case ElemType::Tet10: return "tet10";
+    case ElemType::Hex8:
+      return "hex8";
+    case ElemType::Tet4:
+      return "tet4";
+    case ElemType::Tet10:
+      return "tet10";
   }
   return "?";
 }
@@ -29,13 +32,16 @@ const std::vector<QuadPoint>& volume_rule(ElemType t) {
   static const std::vector<QuadPoint> tet1 = {{{0.25, 0.25, 0.25}, 1.0 / 6.0}};
   static const std::vector<QuadPoint> tet4 = [] {
     const double a = 0.5854101966249685, b = 0.1381966011250105;
-    return std::vector<QuadPoint>{{{b, b, b}, 1.0 / 24.0}, {{a, b, b}, 1.0 / 24.0}, {{b, a, b}, 1.0 / 24.0},
-                                  {{b, b, a}, 1.0 / 24.0}};
+    return std::vector<QuadPoint>{
+        {{b, b, b}, 1.0 / 24.0}, {{a, b, b}, 1.0 / 24.0}, {{b, a, b}, 1.0 / 24.0}, {{b, b, a}, 1.0 / 24.0}};
   }();
   switch (t) {
-    case ElemType::Hex8: return hex;
-    case ElemType::Tet4: return tet1;
-    case ElemType::Tet10: return tet4;
+    case ElemType::Hex8:
+      return hex;
+    case ElemType::Tet4:
+      return tet1;
+    case ElemType::Tet10:
+      return tet4;
   }
   throw std::logic_error("volume_rule");
 }
@@ -52,9 +58,12 @@ const std::vector<QuadPoint>& face_rule(FaceType t) {
   static const std::vector<QuadPoint> quad = from_contact(FaceType::Quad4, 3), tri3 = from_contact(FaceType::Tri3, 2),
                                       tri6 = from_contact(FaceType::Tri6, 4);
   switch (t) {
-    case FaceType::Quad4: return quad;
-    case FaceType::Tri3: return tri3;
-    case FaceType::Tri6: return tri6;
+    case FaceType::Quad4:
+      return quad;
+    case FaceType::Tri3:
+      return tri3;
+    case FaceType::Tri6:
+      return tri6;
   }
   throw std::logic_error("face_rule");
 }
@@ -110,10 +119,11 @@ std::vector<Vec3d> reference_nodes(ElemType t) {
   switch (t) {
     case ElemType::Hex8:
       return {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
-    case ElemType::Tet4: return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    case ElemType::Tet4:
+      return {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     case ElemType::Tet10:
-      return {{0, 0, 0},     {1, 0, 0},     {0, 1, 0},   {0, 0, 1},     {0.5, 0, 0},
-              {0.5, 0.5, 0}, {0, 0.5, 0},   {0, 0, 0.5}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
+      return {{0, 0, 0},     {1, 0, 0},   {0, 1, 0},   {0, 0, 1},     {0.5, 0, 0},
+              {0.5, 0.5, 0}, {0, 0.5, 0}, {0, 0, 0.5}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
   }
   return {};
 }
@@ -132,9 +142,12 @@ const std::vector<LocalFace>& local_faces(ElemType t) {
                                                {FaceType::Tri6, {1, 2, 3, 5, 8, 9}},
                                                {FaceType::Tri6, {0, 3, 2, 7, 8, 6}}};
   switch (t) {
-    case ElemType::Hex8: return hex;
-    case ElemType::Tet4: return tet4;
-    case ElemType::Tet10: return tet10;
+    case ElemType::Hex8:
+      return hex;
+    case ElemType::Tet4:
+      return tet4;
+    case ElemType::Tet10:
+      return tet10;
   }
   throw std::logic_error("local_faces");
 }
@@ -188,8 +201,8 @@ bool element_internal_fixed(const Eigen::MatrixXd& Xd, const Eigen::MatrixXd& ud
     const Mat3 C = F.transpose() * F;
     if (visc) {  // S = S∞ + Q (eq. B.8), Q from eq. B.7 integrated over the step
       Vec6 Q, Sv;
-      viscous_stress_tangent(mat, fibers, visc->branch, visc->dt, visc->Q_n[q], visc->S_n[q], C, S,
-                             K ? &D : nullptr, Q, Sv);
+      viscous_stress_tangent(mat, fibers, visc->branch, visc->dt, visc->Q_n[q], visc->S_n[q], C, S, K ? &D : nullptr, Q,
+                             Sv);
       if (visc->Q_out) visc->Q_out[q] = Q;
       if (visc->S_out) visc->S_out[q] = Sv;
     } else {
@@ -233,9 +246,12 @@ bool element_internal(ElemType t, const Eigen::MatrixXd& X, const Eigen::MatrixX
                       const std::vector<FiberFamily>& fibers, Eigen::VectorXd& f, Eigen::MatrixXd* K,
                       ElementStress* out, const ViscousHistory* visc) {
   switch (t) {
-    case ElemType::Hex8: return element_internal_fixed<ElemType::Hex8>(X, u, mat, fibers, f, K, out, visc);
-    case ElemType::Tet4: return element_internal_fixed<ElemType::Tet4>(X, u, mat, fibers, f, K, out, visc);
-    case ElemType::Tet10: return element_internal_fixed<ElemType::Tet10>(X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Hex8:
+      return element_internal_fixed<ElemType::Hex8>(X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Tet4:
+      return element_internal_fixed<ElemType::Tet4>(X, u, mat, fibers, f, K, out, visc);
+    case ElemType::Tet10:
+      return element_internal_fixed<ElemType::Tet10>(X, u, mat, fibers, f, K, out, visc);
   }
   return false;
 }

@@ -38,8 +38,8 @@ void add_stress(const NeoHooke& m, const Mat3& C, Mat3& S, Mat6* D) {
       const int i = kVoigt[I][0], j = kVoigt[I][1];
       for (int K = 0; K < 6; ++K) {
         const int k = kVoigt[K][0], l = kVoigt[K][1];
-        (*D)(I, K) += 2.0 * mu * beta * Jm2b * Ci(i, j) * Ci(k, l) +
-                      mu * Jm2b * (Ci(i, k) * Ci(j, l) + Ci(i, l) * Ci(j, k));
+        (*D)(I, K) +=
+            2.0 * mu * beta * Jm2b * Ci(i, j) * Ci(k, l) + mu * Jm2b * (Ci(i, k) * Ci(j, l) + Ci(i, l) * Ci(j, k));
       }
     }
   }
@@ -57,8 +57,8 @@ void add_stress(const FiberFamily& f, const Mat3& C, Mat3& S, Mat6* D) {
   if (f.tension_only && I4 <= 1.0) return;  // fibers carry tension only
   const double e = I4 - 1.0;
   const double ex = std::exp(f.k2 * e * e);
-  const double dpsi = f.k1 * e * ex;                                // dPsi/dI4
-  const double d2psi = f.k1 * ex * (1.0 + 2.0 * f.k2 * e * e);     // d2Psi/dI4^2
+  const double dpsi = f.k1 * e * ex;                            // dPsi/dI4
+  const double d2psi = f.k1 * ex * (1.0 + 2.0 * f.k2 * e * e);  // d2Psi/dI4^2
   const Mat3 A = f.a0 * f.a0.transpose();
   S += 2.0 * dpsi * A;
   if (D) {
@@ -91,8 +91,7 @@ double energy(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const M
   return psi;
 }
 
-void stress_tangent(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C, Mat3& S,
-                    Mat6* D) {
+void stress_tangent(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C, Mat3& S, Mat6* D) {
   S.setZero();
   if (D) D->setZero();
   add_stress(m, C, S, D);

@@ -133,8 +133,12 @@ Key corner_key(const int* n, int nc) {
 }
 void flip(Face& f) {
   switch (f.type) {
-    case FaceType::Quad4: std::swap(f.n[1], f.n[3]); break;
-    case FaceType::Tri3: std::swap(f.n[1], f.n[2]); break;
+    case FaceType::Quad4:
+      std::swap(f.n[1], f.n[3]);
+      break;
+    case FaceType::Tri3:
+      std::swap(f.n[1], f.n[2]);
+      break;
     case FaceType::Tri6:
       std::swap(f.n[1], f.n[2]);
       std::swap(f.n[3], f.n[5]);
@@ -207,8 +211,7 @@ Mesh make_tube(const TubeSpec& s) {
   for (int k = 0; k < na; ++k) {
     const double zk = s.length * k / s.n_axial;  // from end0
     const double rl = s.stenosis.lumen_radius(s.inner_radius, zk - 0.5 * s.length);
-    for (int j = 0; j < nr; ++j)
-      r[j] = j <= n1 ? rl + (radii[n1] - rl) * j / n1 : radii[j];
+    for (int j = 0; j < nr; ++j) r[j] = j <= n1 ? rl + (radii[n1] - rl) * j / n1 : radii[j];
     for (int j = 0; j < nr; ++j)
       for (int i = 0; i < nc; ++i) {
         const double th = 2.0 * std::numbers::pi * i / nc;
@@ -225,7 +228,7 @@ Mesh make_tube(const TubeSpec& s) {
         e.type = ElemType::Hex8;
         e.block = layer_of_shell[j];
         // xi: radial, eta: circumferential, zeta: axial -> positive Jacobian
-        e.n = {node(i, j, k), node(i, j + 1, k), node(i + 1, j + 1, k), node(i + 1, j, k),
+        e.n = {node(i, j, k),     node(i, j + 1, k),     node(i + 1, j + 1, k),     node(i + 1, j, k),
                node(i, j, k + 1), node(i, j + 1, k + 1), node(i + 1, j + 1, k + 1), node(i + 1, j, k + 1)};
         m.elements.push_back(e);
       }
@@ -424,10 +427,10 @@ class MshInput {
 // types as gmsh 4.8's getElementProperties reports them); 0: unknown or variable (polygons), such
 // elements cannot be skipped in a binary file.
 int gmsh_node_count(int type) {
-  static constexpr int kNodes[67] = {
-      0,  2,  3,  4,  4,  8,  6,  5,  3,  6,  9,  10, 27, 18, 14, 1,  8,  20, 15, 13, 9,  10, 12,
-      15, 15, 21, 4,  5,  6,  20, 35, 56, 22, 28, 0,  0,  16, 25, 36, 12, 16, 20, 28, 36, 45, 55,
-      66, 49, 64, 81, 100, 121, 18, 21, 24, 27, 30, 24, 28, 32, 36, 40, 7,  8,  9,  10, 11};
+  static constexpr int kNodes[67] = {0,   2,  3,  4,  4,  8,  6,  5,  3,  6,  9,  10, 27, 18, 14, 1,  8,
+                                     20,  15, 13, 9,  10, 12, 15, 15, 21, 4,  5,  6,  20, 35, 56, 22, 28,
+                                     0,   0,  16, 25, 36, 12, 16, 20, 28, 36, 45, 55, 66, 49, 64, 81, 100,
+                                     121, 18, 21, 24, 27, 30, 24, 28, 32, 36, 40, 7,  8,  9,  10, 11};
   if (type >= 0 && type < 67) return kNodes[type];
   if (type == 92) return 64;   // hex64
   if (type == 93) return 125;  // hex125
@@ -443,13 +446,26 @@ struct GmshElement {
 std::optional<GmshElement> supported_element(int type, int entity_dim) {
   std::optional<GmshElement> e;
   switch (type) {
-    case 5: e = GmshElement{true, ElemType::Hex8, {}}; break;
-    case 4: e = GmshElement{true, ElemType::Tet4, {}}; break;
-    case 11: e = GmshElement{true, ElemType::Tet10, {}}; break;
-    case 3: e = GmshElement{false, {}, FaceType::Quad4}; break;
-    case 2: e = GmshElement{false, {}, FaceType::Tri3}; break;
-    case 9: e = GmshElement{false, {}, FaceType::Tri6}; break;
-    default: return std::nullopt;
+    case 5:
+      e = GmshElement{true, ElemType::Hex8, {}};
+      break;
+    case 4:
+      e = GmshElement{true, ElemType::Tet4, {}};
+      break;
+    case 11:
+      e = GmshElement{true, ElemType::Tet10, {}};
+      break;
+    case 3:
+      e = GmshElement{false, {}, FaceType::Quad4};
+      break;
+    case 2:
+      e = GmshElement{false, {}, FaceType::Tri3};
+      break;
+    case 9:
+      e = GmshElement{false, {}, FaceType::Tri6};
+      break;
+    default:
+      return std::nullopt;
   }
   if (entity_dim != (e->volume ? 3 : 2)) return std::nullopt;
   return e;
@@ -542,7 +558,8 @@ Mesh GmshMeshBuilder::finish(const std::string& path) {
   for (auto& s : m.surfaces)
     for (auto& f : s.faces)
       for (int a = 0; a < f.nn(); ++a) {
-        if (used[f.n[a]] < 0) throw std::runtime_error(path + ": surface " + s.name + " has nodes outside the volume mesh");
+        if (used[f.n[a]] < 0)
+          throw std::runtime_error(path + ": surface " + s.name + " has nodes outside the volume mesh");
         f.n[a] = used[f.n[a]];
       }
   m.X = std::move(X);
@@ -569,13 +586,15 @@ void read_mesh_format(MshInput& in) {
   if (version != "4.1")  // 2.x and 4.0 lay the sections out differently
     in.fail("MSH " + version + (file_type == 1 ? " binary" : " ASCII") +
             " is not supported, expected MSH 4.1 ASCII or binary (gmsh: -format msh41, or Mesh.MshFileVersion = 4.1)");
-  if (file_type != 0 && file_type != 1) in.fail("file-type " + std::to_string(file_type) + ", expected 0 (ASCII) or 1 (binary)");
+  if (file_type != 0 && file_type != 1)
+    in.fail("file-type " + std::to_string(file_type) + ", expected 0 (ASCII) or 1 (binary)");
   in.skip_line();
   if (file_type == 1) {
     if (data_size != 8) in.fail("data-size " + std::to_string(data_size) + ", expected 8 (double)");
     in.set_binary(true);
     const int32_t one = in.value<int32_t>("byte order mark (int 1)");
-    if (one == 0x01000000) in.fail("the file was written in the opposite byte order to this machine's (write it as ASCII)");
+    if (one == 0x01000000)
+      in.fail("the file was written in the opposite byte order to this machine's (write it as ASCII)");
     if (one != 1) in.fail("bad byte order mark " + std::to_string(one) + ", expected the int 1");
   }
   in.end_section("$EndMeshFormat");

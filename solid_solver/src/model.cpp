@@ -42,9 +42,9 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
   for (size_t e = 0; e < mesh_.elements.size(); ++e) {
     const auto& mat = materials_[mesh_.elements[e].block];
     if (!mat.fibers.empty())
-      fibers_[e] = resolve_fibers(mat, mesh_.frames.size() == mesh_.elements.size()
-                                           ? mesh_.frames[e]
-                                           : element_frame(mesh_, int(e), opt_.axis));
+      fibers_[e] =
+          resolve_fibers(mat, mesh_.frames.size() == mesh_.elements.size() ? mesh_.frames[e]
+                                                                           : element_frame(mesh_, int(e), opt_.axis));
   }
   // reference Jacobians must be positive (catches inverted elements of imported meshes early)
   std::vector<double> volume(mesh_.elements.size(), 0.0);  // reference volume per element
@@ -389,8 +389,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     const auto& el = mesh_.elements[e];
     gather_nodes(el.n.data(), el.nn(), false);
     const auto& mat = materials_[el.block].matrix;
-    if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr, nullptr,
-                          viscous_history_(i, vh))) {
+    if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr, nullptr, viscous_history_(i, vh))) {
       ok = 0;
       bad = e;
       break;
@@ -485,7 +484,8 @@ SolveReport SolidModel::solve(double loose_atol) {
       rep.assembly_seconds += MPI_Wtime() - tl;
       if (lok) {
         std::vector<PetscScalar> inc(dirichlet_rows_.size());
-        for (size_t i = 0; i < dirichlet_rows_.size(); ++i) inc[i] = u_target[dirichlet_rows_[i]] - u_[dirichlet_rows_[i]];
+        for (size_t i = 0; i < dirichlet_rows_.size(); ++i)
+          inc[i] = u_target[dirichlet_rows_[i]] - u_[dirichlet_rows_[i]];
         ANGIO_PETSC(VecSet(du_, 0.0));
         ANGIO_PETSC(VecSetValues(du_, PetscInt(inc.size()), dirichlet_rows_.data(), inc.data(), INSERT_VALUES));
         ANGIO_PETSC(VecAssemblyBegin(du_));
@@ -538,7 +538,9 @@ SolveReport SolidModel::solve(double loose_atol) {
   // fresh: K_ holds the tangent at the current iterate (to be factorized); otherwise the modified
   // Newton iterates with the factorization held by the KSP.
   bool fresh = !modified || !pc_current_;
-  if (!assemble_here(fresh)) return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN; " + invalid_element() + ")");
+  if (!assemble_here(fresh))
+    return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN; " + invalid_element() +
+                ")");
   double res = norm(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
@@ -565,8 +567,8 @@ SolveReport SolidModel::solve(double loose_atol) {
     }
     if (it >= no.max_iterations) {
       std::ostringstream m;
-      m << "Newton did not converge in " << no.max_iterations << " iterations (residual " << res << ", initial "
-        << res0 << ")";
+      m << "Newton did not converge in " << no.max_iterations << " iterations (residual " << res << ", initial " << res0
+        << ")";
       return fail(m.str());
     }
     // linear solve K du = -r
@@ -592,7 +594,9 @@ SolveReport SolidModel::solve(double loose_atol) {
       pc_current_ = reason > 0 || reason == KSP_DIVERGED_ITS;
       if (reuse && reason < 0) {  // the old factorization no longer serves: the current tangent instead
         rep.linear_seconds += MPI_Wtime() - t0;
-        if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
+        if (!current_tangent())
+          return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() +
+                      ")");
         continue;
       }
     } else {
@@ -605,8 +609,8 @@ SolveReport SolidModel::solve(double loose_atol) {
     rep.linear_seconds += MPI_Wtime() - t0;
     if (reason < 0 && reason != KSP_DIVERGED_ITS) {
       std::ostringstream m;
-      m << "linear solver failed at Newton iteration " << it << ": " << KSPConvergedReasons[reason] << " after "
-        << lits << " iterations (residual " << res << ")";
+      m << "linear solver failed at Newton iteration " << it << ": " << KSPConvergedReasons[reason] << " after " << lits
+        << " iterations (residual " << res << ")";
       return fail(m.str());
     }
     gather_(du_, du_full);
@@ -637,7 +641,8 @@ SolveReport SolidModel::solve(double loose_atol) {
     }
     if (stale && !(new_res < res)) {  // the old factorization diverges here: back, and the current tangent
       u_ = u_base;
-      if (!current_tangent()) return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
+      if (!current_tangent())
+        return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
       continue;
     }
     if (!accepted && !stale) {
@@ -656,7 +661,8 @@ SolveReport SolidModel::solve(double loose_atol) {
       // keep the factorization while it contracts fast enough; otherwise the tangent here, for the
       // next iteration (the residual is assembled again with it)
       fresh = !(new_res <= no.max_contraction * res) && !converged(new_res, it + 1);
-      if (fresh && !assemble_here(true)) return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
+      if (fresh && !assemble_here(true))
+        return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
     }
     res = new_res;
     rep.residual_history.push_back(res);
@@ -679,9 +685,9 @@ SolveReport SolidModel::solve(double loose_atol) {
       if (rank_ == 0) {
         const int node = at_global >= 0 ? iperm_[at_global / 3] : -1;
         const Vec3d x = node >= 0 ? position(node) : Vec3d::Zero();
-        std::printf("    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)\n",
-                    it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1),
-                    x(2));
+        std::printf(
+            "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)\n",
+            it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1), x(2));
       }
     }
   }
@@ -769,7 +775,7 @@ bool SolidModel::predict() {
   if (u_before_.size() != u_.size() || !(committed_time_ > before_time_) || !(time_ > committed_time_)) return false;
   const double f = (time_ - committed_time_) / (committed_time_ - before_time_);
   for (size_t i = 0; i < u_.size(); ++i) u_[i] += f * (u_committed_[i] - u_before_[i]);
-  apply_dirichlet_values_();  // prescribed values exact at the new time: no lifting solve for them
+  apply_dirichlet_values_();               // prescribed values exact at the new time: no lifting solve for them
   if (assemble(r_, nullptr)) return true;  // collective: false on every rank if any element inverted
   u_ = u_committed_;
   return false;
@@ -789,8 +795,7 @@ void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir
     element_state_(e, X, u);
     ElementStress es;
     ViscousHistory vh;
-    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, &es,
-                     viscous_history_(i, vh));
+    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, &es, viscous_history_(i, vh));
     Eigen::SelfAdjointEigenSolver<Mat3> eig(es.cauchy_avg);
     p1[i] = eig.eigenvalues()(2);
     dir[i] = eig.eigenvectors().col(2);

@@ -69,8 +69,7 @@ std::vector<std::string> cell_vector_names(const SolidModel& model) {
 std::vector<Vec3d> cell_vectors(const SolidModel& model, int e, size_t count) {
   const Frame& f = model.mesh().frames[e];
   std::vector<Vec3d> v{f.circumferential, f.axial, f.radial};
-  for (const auto& fiber : resolve_fibers(model.materials()[model.mesh().elements[e].block], f))
-    v.push_back(fiber.a0);
+  for (const auto& fiber : resolve_fibers(model.materials()[model.mesh().elements[e].block], f)) v.push_back(fiber.a0);
   v.resize(count, Vec3d::Zero());
   return v;
 }
@@ -80,17 +79,19 @@ std::vector<Vec3d> cell_vectors(const SolidModel& model, int e, size_t count) {
 void xdmf_attribute(std::ostream& x, const std::string& name, const char* center, long rows, int cols,
                     const std::string& path, const char* number = "Float") {
   const bool real = std::string(number) == "Float";
-  x << "     <Attribute Name=\"" << name << "\" AttributeType=\"" << (cols == 3 ? "Vector" : "Scalar")
-    << "\" Center=\"" << center << "\">\n      <DataItem Dimensions=\"" << rows << (cols == 3 ? " 3" : "")
-    << "\" NumberType=\"" << number << "\"" << (real ? " Precision=\"8\"" : "") << " Format=\"HDF\">" << path
-    << "</DataItem>\n     </Attribute>\n";
+  x << "     <Attribute Name=\"" << name << "\" AttributeType=\"" << (cols == 3 ? "Vector" : "Scalar") << "\" Center=\""
+    << center << "\">\n      <DataItem Dimensions=\"" << rows << (cols == 3 ? " 3" : "") << "\" NumberType=\"" << number
+    << "\"" << (real ? " Precision=\"8\"" : "") << " Format=\"HDF\">" << path << "</DataItem>\n     </Attribute>\n";
 }
 
 const char* xdmf_topology(ElemType t) {
   switch (t) {
-    case ElemType::Hex8: return "Hexahedron";
-    case ElemType::Tet4: return "Tetrahedron";
-    case ElemType::Tet10: return "Tetrahedron_10";
+    case ElemType::Hex8:
+      return "Hexahedron";
+    case ElemType::Tet4:
+      return "Tetrahedron";
+    case ElemType::Tet10:
+      return "Tetrahedron_10";
   }
   return "";
 }

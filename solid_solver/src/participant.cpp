@@ -87,8 +87,8 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
   }
   record_and_write_(0, time_);
   if (rank_ == 0) {
-    LOG_INFO("solid: " << model_->mesh().elements.size() << " elements, " << model_->num_dofs() << " DOFs on "
-                       << size << " rank(s); blocks:" << [&] {
+    LOG_INFO("solid: " << model_->mesh().elements.size() << " elements, " << model_->num_dofs() << " DOFs on " << size
+                       << " rank(s); blocks:" << [&] {
                             std::string s;
                             for (const auto& b : model_->mesh().blocks) s += " " + b.name;
                             return s;
@@ -98,8 +98,8 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
       LOG_INFO("solid: peak pressure load " << F << " N (reference mesh), Newton atol " << atol << " N = " << atol / F
                                             << " of it");
     if (F > 0.0 && atol > kWarnAtolOfLoad * F)
-      LOG_WARN("solid.newton.atol = " << atol << " N is more than " << kWarnAtolOfLoad
-                                      << " of the peak pressure load (" << scene_.peak_load_norm
+      LOG_WARN("solid.newton.atol = " << atol << " N is more than " << kWarnAtolOfLoad << " of the peak pressure load ("
+                                      << scene_.peak_load_norm
                                       << " N): the equilibrium error it accepts may show in the results");
   }
 }
@@ -149,7 +149,7 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
   stent_x_ = pts.x;
   if (!pts.x.empty() && !stent_contact_ && !warned_contact_ && rank_ == 0) {
     LOG_WARN("solid: no stent contact configured; " << pts.x.size()
-                                                     << " beam sample points are ignored (zero line loads)");
+                                                    << " beam sample points are ignored (zero line loads)");
     warned_contact_ = true;
   }
   reset_reply(pts, reply);
@@ -218,8 +218,8 @@ SolveReport SolidRunner::continuation_(const participant::SamplePoints& pts, con
   set_stage(1.0);  // the solve's own time and points, whatever happened
   if (lambda >= 1.0) {
     if (rank_ == 0)
-      LOG_INFO("solid step " << step_ << " t = " << time_ << ": Newton failed (" << failed.message
-                             << "); continued in " << stages << " sub-increments (" << halvings << " halvings)");
+      LOG_INFO("solid step " << step_ << " t = " << time_ << ": Newton failed (" << failed.message << "); continued in "
+                             << stages << " sub-increments (" << halvings << " halvings)");
     return rep;
   }
   SolveReport out = failed;
@@ -255,8 +255,9 @@ void SolidRunner::end_step(bool accept) {
     os << " max_p1[";
     for (size_t b = 0; b < h.max_p1.size(); ++b)
       os << (b ? " " : "") << model_->mesh().blocks[b].name << "=" << h.max_p1[b];
-    os << "]MPa ksp=" << last_.linear_iterations << " pc_setups=" << last_.factorizations << std::setprecision(3) << " " << last_.total_seconds
-       << "s (assembly " << last_.assembly_seconds << "s, linear " << last_.linear_seconds << "s)";
+    os << "]MPa ksp=" << last_.linear_iterations << " pc_setups=" << last_.factorizations << std::setprecision(3) << " "
+       << last_.total_seconds << "s (assembly " << last_.assembly_seconds << "s, linear " << last_.linear_seconds
+       << "s)";
     LOG_INFO(os.str());
   }
 }
@@ -565,7 +566,7 @@ void SolidRunner::write_state_() {
     write_state_file(*model_, dir_ + "/state.h5", committed_);
   } catch (const std::exception& e) {
     LOG_WARN("solid: state file not written at step " << committed_ << ": " << e.what()
-                                                       << " (the previous one, if any, is kept)");
+                                                      << " (the previous one, if any, is kept)");
   }
 }
 
@@ -659,8 +660,11 @@ int run_follower(participant::SolidParticipant& inner, MPI_Comm comm) {
         inner.end_step(a != 0);
         break;
       }
-      case kFinish: inner.finish(); return 0;
-      default: return 1;
+      case kFinish:
+        inner.finish();
+        return 0;
+      default:
+        return 1;
     }
   }
 }

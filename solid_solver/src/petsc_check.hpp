@@ -5,9 +5,9 @@
 #include <stdexcept>
 #include <string>
 
-#define ANGIO_PETSC(call)                                                                     \
-  do {                                                                                      \
-    PetscErrorCode ierr_ = (call);                                                          \
-    if (ierr_) throw std::runtime_error(std::string("PETSc error in ") + #call + " (code " + \
-                                        std::to_string(int(ierr_)) + ")");                  \
+#define ANGIO_PETSC(call)                                                                                              \
+  do {                                                                                                                 \
+    PetscErrorCode ierr_ = (call);                                                                                     \
+    if (ierr_)                                                                                                         \
+      throw std::runtime_error(std::string("PETSc error in ") + #call + " (code " + std::to_string(int(ierr_)) + ")"); \
   } while (0)

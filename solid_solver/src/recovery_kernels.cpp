@@ -26,9 +26,12 @@ const std::vector<QuadPoint>& recovery_rule(ElemType t) {
   }();
   static const std::vector<QuadPoint> tet4 = volume_rule(ElemType::Tet10);  // the 4-point degree-2 rule
   switch (t) {
-    case ElemType::Hex8: return volume_rule(ElemType::Hex8);
-    case ElemType::Tet4: return tet4;
-    case ElemType::Tet10: return tet14;
+    case ElemType::Hex8:
+      return volume_rule(ElemType::Hex8);
+    case ElemType::Tet4:
+      return tet4;
+    case ElemType::Tet10:
+      return tet14;
   }
   throw std::logic_error("recovery_rule");
 }
@@ -83,9 +86,12 @@ const RecoveryCache& cache(ElemType t) {
   };
   static const RecoveryCache hex = build(ElemType::Hex8), tet4 = build(ElemType::Tet4), tet10 = build(ElemType::Tet10);
   switch (t) {
-    case ElemType::Hex8: return hex;
-    case ElemType::Tet4: return tet4;
-    case ElemType::Tet10: return tet10;
+    case ElemType::Hex8:
+      return hex;
+    case ElemType::Tet4:
+      return tet4;
+    case ElemType::Tet10:
+      return tet10;
   }
   throw std::logic_error("recovery cache");
 }

@@ -164,11 +164,11 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     (void)required_surfaces;
     return m;
   }
-  mesh.check_keys(layered ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ",
-                                                               "n_axial", "center", "layers", "centerline", "start",
-                                                               "stenosis"}
-                          : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall",
-                                                               "n_circ", "n_axial", "center", "centerline", "start"});
+  mesh.check_keys(layered
+                      ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ", "n_axial",
+                                                           "center", "layers", "centerline", "start", "stenosis"}
+                      : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall", "n_circ",
+                                                           "n_axial", "center", "centerline", "start"});
   mesh.choice("generator", {"tube"});
   TubeSpec t;
   t.part = part;
@@ -181,7 +181,8 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   double wall = 0.0;
   if (layered) {
     const Node layers = mesh.child("layers", "a list of layers {name, thickness, n_radial} from inside out");
-    if (!layers.is_sequence() || layers.size() == 0) layers.fail("a non-empty list of layers {name, thickness, n_radial}");
+    if (!layers.is_sequence() || layers.size() == 0)
+      layers.fail("a non-empty list of layers {name, thickness, n_radial}");
     for (size_t i = 0; i < layers.size(); ++i) {
       const Node l = layers.at(i);
       l.check_keys({"name", "thickness", "n_radial"});
@@ -197,19 +198,21 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     t.layers = {{part, wall, 1}};
   }
   t.inner_radius = ro - wall;
-  if (!(t.inner_radius > 0)) mesh.child("outer_diameter").fail("an outer diameter larger than twice the wall thickness");
+  if (!(t.inner_radius > 0))
+    mesh.child("outer_diameter").fail("an outer diameter larger than twice the wall thickness");
   if (auto st = mesh.optional("stenosis")) {  // idealized concentric stenosis (mesh.hpp, TubeStenosis)
     st->check_keys({"severity", "length", "position"});
     t.stenosis.severity = st->in_range("severity", 0.0, 0.9);  // diameter stenosis; 90 % leaves a 10 % lumen
     t.stenosis.length = st->positive("length");
     t.stenosis.position = st->number_or("position", 0.0);
     if (std::abs(t.stenosis.position) + 0.5 * t.stenosis.length > 0.5 * t.length)
-      st->child("length").fail("a stenosis within the tube (|position| + length/2 <= " + std::to_string(0.5 * t.length) +
-                               " mm)");
+      st->child("length").fail(
+          "a stenosis within the tube (|position| + length/2 <= " + std::to_string(0.5 * t.length) + " mm)");
   }
   if (auto cl = mesh.optional("centerline")) {
     // curved tube: the straight tube warped onto the centerline like the stent (paper §2.4)
-    if (mesh.has("center")) mesh.child("center").fail("no 'center' with a 'centerline' (a curved tube is placed by centerline and start)");
+    if (mesh.has("center"))
+      mesh.child("center").fail("no 'center' with a 'centerline' (a curved tube is placed by centerline and start)");
     geometry::Centerline c = geometry::centerline_from_scene(*cl);
     const std::string source = cl->is_map() && cl->has("file") ? cl->string("file") : "the given points";
     if (mesh.has("start")) {
@@ -254,8 +257,8 @@ PressureSpec read_pressure(const Node& parent, const std::string& key, const std
   const double peak = std::max(std::abs(lo), std::abs(hi));
   if (peak > max_peak) {
     std::ostringstream m;
-    m << "a peak pressure (value x load curve) of at most " << max_peak << " MPa (" << limit_reason << "), got "
-      << peak << " MPa";
+    m << "a peak pressure (value x load curve) of at most " << max_peak << " MPa (" << limit_reason << "), got " << peak
+      << " MPa";
     parent.child(key).fail(m.str());
   }
   return PressureSpec{surface, c.value, c.curve, label};
@@ -334,8 +337,8 @@ SolidScene read_solid_scene(const Node& root) {
     std::vector<std::string> req;
     double length = 0;
     std::optional<geometry::Centerline> curved;
-    Mesh m = read_part_mesh(b->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false,
-                            axis, req, length, curved);
+    Mesh m = read_part_mesh(b->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false, axis,
+                            req, length, curved);
     for (auto& blk : m.blocks) blk.name = m.blocks.size() == 1 ? "balloon" : "balloon_" + blk.name;
     const LayerMaterial mat = read_material(b->child("material", "a material {E, nu, fibers}"), "balloon");
     const int boff = int(sc.mesh.blocks.size());
@@ -345,8 +348,9 @@ SolidScene read_solid_scene(const Node& root) {
       sc.materials.push_back(mi);
     }
     (void)boff;
-    if (b->has("pressure")) sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure",
-                                                           kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
+    if (b->has("pressure"))
+      sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure",
+                                           kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
     if (b->has("end_springs")) {
       const double k = b->positive("end_springs");
       for (const char* s : {"balloon_end0", "balloon_end1"}) {
@@ -369,7 +373,8 @@ SolidScene read_solid_scene(const Node& root) {
       if (auto s = b->optional("summary")) {
         s->check_keys({"end_offset"});
         end_offset = s->non_negative_or("end_offset", end_offset);
-        if (!(2 * end_offset < smax - smin)) s->child("end_offset").fail("an offset smaller than half the balloon length");
+        if (!(2 * end_offset < smax - smin))
+          s->child("end_offset").fail("an offset smaller than half the balloon length");
       }
       d.s_mid = 0.5 * (smin + smax);
       d.s_end0 = smin + end_offset;
@@ -392,8 +397,8 @@ SolidScene read_solid_scene(const Node& root) {
     std::vector<std::string> req;
     double length = 0;
     std::optional<geometry::Centerline> curved;
-    Mesh m = read_part_mesh(a->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis,
-                            req, length, curved);
+    Mesh m = read_part_mesh(a->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis, req,
+                            length, curved);
     const Node layers = a->child("layers", "a map layer name -> material {E, nu, fibers}");
     if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
     for (const auto& blk : m.blocks) {
@@ -403,8 +408,8 @@ SolidScene read_solid_scene(const Node& root) {
     for (const auto& k : layers.keys())
       if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
     if (a->has("blood_pressure"))
-      sc.pressures.push_back(read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure",
-                                             kMaxBloodPressure, "300 mmHg"));
+      sc.pressures.push_back(
+          read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure", kMaxBloodPressure, "300 mmHg"));
     if (a->has("end_springs")) {
       const double k = a->positive("end_springs");
       for (const char* s : {"artery_end0", "artery_end1"}) {
@@ -429,7 +434,8 @@ SolidScene read_solid_scene(const Node& root) {
     }
     sc.mesh.append(m);
   }
-  if (!sc.has_balloon && !sc.has_artery) root.fail("a scene with a 'balloon:' and/or 'artery:' section for the solid solver");
+  if (!sc.has_balloon && !sc.has_artery)
+    root.fail("a scene with a 'balloon:' and/or 'artery:' section for the solid solver");
   for (size_t i = 0; i < sc.mesh.blocks.size(); ++i)
     for (size_t j = 0; j < i; ++j)
       if (sc.mesh.blocks[i].name == sc.mesh.blocks[j].name)
@@ -438,8 +444,8 @@ SolidScene read_solid_scene(const Node& root) {
   if (auto s = root.optional("solid")) {
     s->check_keys({"ranks", "partitioner", "petsc_options", "newton", "initial_state"});
     sc.ranks = int(s->integer_or("ranks", 0, 1));
-    sc.options.partitioner = s->choice_or("partitioner", {"contiguous", "ptscotch", "parmetis", "average", "square"},
-                                          "contiguous");
+    sc.options.partitioner =
+        s->choice_or("partitioner", {"contiguous", "ptscotch", "parmetis", "average", "square"}, "contiguous");
     sc.options.petsc_options = s->string_or("petsc_options", "");
     if (auto n = s->optional("newton")) {
       n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
@@ -475,11 +481,14 @@ SolidScene read_solid_scene(const Node& root) {
       no.continuation = int(cont);
       no.extrapolate = n->choice_or("prediction", {"constant", "extrapolate"},
                                     no.extrapolate ? "extrapolate" : "constant") == "extrapolate";
-      if (!(no.max_contraction < 1.0)) n->child("max_contraction").fail("a contraction factor between 0 and 1 (exclusive)");
+      if (!(no.max_contraction < 1.0))
+        n->child("max_contraction").fail("a contraction factor between 0 and 1 (exclusive)");
       if (n->optional("max_contraction") && !no.modified)
-        n->child("max_contraction").fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");
+        n->child("max_contraction")
+            .fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");
       if (no.modified && no.reuse_preconditioner > 0)
-        n->child("reuse_preconditioner").fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
+        n->child("reuse_preconditioner")
+            .fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
     }
   }
   if (auto s = root.optional("solid"))

@@ -131,7 +131,8 @@ StateFile read_state_file(const std::string& path) {
   h5::QuietErrors quiet;
   H5Id file(h5::open_for_reading(r), H5Fclose);
   const int format = r.attribute<int>(file, "format", H5T_NATIVE_INT);
-  if (format != kFormat) r.fail("state file format " + std::to_string(format) + ", this solver reads " + std::to_string(kFormat));
+  if (format != kFormat)
+    r.fail("state file format " + std::to_string(format) + ", this solver reads " + std::to_string(kFormat));
   s.time = r.attribute<double>(file, "time", H5T_NATIVE_DOUBLE);
   s.step = r.attribute<int>(file, "step", H5T_NATIVE_INT);
   if (!std::isfinite(s.time)) r.fail("time is not finite");
@@ -147,7 +148,7 @@ StateFile read_state_file(const std::string& path) {
     p.name = name;
     H5Id g(H5Gopen2(parts, name, H5P_DEFAULT), H5Gclose);
     const std::string at = "/parts/" + p.name + "/";
-        p.X = r.rows<3>(g, "coordinates");
+    p.X = r.rows<3>(g, "coordinates");
     p.u = r.rows<3>(g, "displacement");
     if (p.u.size() != p.X.size()) r.fail(at + "displacement: not one row per node");
     if (r.exists(g, "displacement_before")) {
@@ -192,9 +193,9 @@ void check_state(const StateFile& state, const Mesh& mesh, const std::vector<std
                            " elements, this scene's mesh " + std::to_string(elems.size()));
     for (size_t k = 0; k < elems.size(); ++k)
       if (viscous_points_of(mesh, materials, elems[k]) != p->viscous_points[k])
-        throw StateFileError(state.path + ": part '" + name + "' element " + std::to_string(k) +
-                             ": viscous history " + (p->viscous_points[k] ? "in the file, not in this scene's material"
-                                                                           : "in this scene's material, not in the file"));
+        throw StateFileError(state.path + ": part '" + name + "' element " + std::to_string(k) + ": viscous history " +
+                             (p->viscous_points[k] ? "in the file, not in this scene's material"
+                                                   : "in this scene's material, not in the file"));
   }
 }
 

@@ -41,8 +41,14 @@ void insert(const SolidModel& model, const std::vector<contact::NodalContributio
 // Global diagnostics from the per-rank slices (sums, min gap), same on every rank.
 ContactSummary reduce_summary(const contact::ContactDiagnostics& d, double area, double radius, MPI_Comm comm,
                               double* area_out) {
-  double sum[8] = {double(d.num_points), double(d.num_active), d.force_on_solid(0), d.force_on_solid(1),
-                   d.force_on_solid(2), d.force_magnitude, d.energy, area};
+  double sum[8] = {double(d.num_points),
+                   double(d.num_active),
+                   d.force_on_solid(0),
+                   d.force_on_solid(1),
+                   d.force_on_solid(2),
+                   d.force_magnitude,
+                   d.energy,
+                   area};
   double g[8];
   MPI_Allreduce(sum, g, 8, MPI_DOUBLE, MPI_SUM, comm);
   double mn = d.min_gap, gmn;

@@ -115,8 +115,9 @@ StressRecovery::StressRecovery(const SolidModel& model, Mass mass) : model_(mode
     MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, comm);
     if (any) {
       release_();  // the destructor does not run for a constructor that throws
-      throw std::runtime_error("stress recovery: the lumped mass has non-positive row sums (tet10 vertices); use the "
-                               "consistent projection");
+      throw std::runtime_error(
+          "stress recovery: the lumped mass has non-positive row sums (tet10 vertices); use the "
+          "consistent projection");
     }
   } else {
     ANGIO_PETSC(KSPCreate(comm, &ksp_));
@@ -151,11 +152,10 @@ bool StressRecovery::recover(const std::vector<Mat3>& gauss) {
   const double t0 = MPI_Wtime();
   const Mesh& mesh = model_.mesh();
   const auto& le = model_.local_elements();
-  const size_t expected =
-      le.empty() ? 0 : gauss_offset_.back() + volume_rule(mesh.elements[le.back()].type).size();
+  const size_t expected = le.empty() ? 0 : gauss_offset_.back() + volume_rule(mesh.elements[le.back()].type).size();
   if (gauss.size() != expected)
-    throw std::invalid_argument("stress recovery: " + std::to_string(gauss.size()) + " Gauss-point stresses, expected " +
-                                std::to_string(expected));
+    throw std::invalid_argument("stress recovery: " + std::to_string(gauss.size()) +
+                                " Gauss-point stresses, expected " + std::to_string(expected));
   for (int k = 0; k < 6; ++k) ANGIO_PETSC(VecSet(b_[k], 0.0));
   // b_e = B_e S_e; fixed-capacity buffers (at most 10 nodes, 8 Gauss points): no allocation per element
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 8, 6> S;

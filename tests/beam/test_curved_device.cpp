@@ -24,11 +24,10 @@ TEST(CurvedDevice, StentCoaxialWithTheBalloonCenterline) {
     smin = std::min(smin, p.s);
     smax = std::max(smax, p.s);
   }
-  EXPECT_NEAR(smax - smin, 16.5, 1e-9);                  // not stretched along the axis
+  EXPECT_NEAR(smax - smin, 16.5, 1e-9);                       // not stretched along the axis
   EXPECT_NEAR(0.5 * (smin + smax), 0.5 * cl.length(), 1e-9);  // centred like the balloon
   // radial fixation of the middle ring w.r.t. the curved axis: 4 nodes on the centerline's
   // normal plane at the middle ring's bottom crowns
   ASSERT_EQ(s.stent->fixation_nodes.size(), 4u);
-  for (int n : s.stent->fixation_nodes)
-    EXPECT_NEAR(cl.closest(s.model->reference_position(n)).s, smin + 5 * 1.5, 1e-9);
+  for (int n : s.stent->fixation_nodes) EXPECT_NEAR(cl.closest(s.model->reference_position(n)).s, smin + 5 * 1.5, 1e-9);
 }

@@ -43,7 +43,8 @@ TEST(BeamSummary, NonFiniteIsNullAndStringsRoundTrip) {
   steps[1].max_bending_moment = std::numeric_limits<double>::infinity();
   StepRecord initial = record(0, 0.0, 1.5);
   const std::string status = "odd \"status\" with a back\\slash and a\nnewline";
-  const auto path = std::filesystem::temp_directory_path() / ("beam_summary_json_test_" + std::to_string(::getpid()) + ".json");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("beam_summary_json_test_" + std::to_string(::getpid()) + ".json");
   const std::string text = write_summary(path.string(), m, steps, false, status, 2.0, 4, initial);
 
   std::ifstream f(path);
@@ -79,7 +80,7 @@ TEST(BeamSummary, NonFiniteIsNullAndStringsRoundTrip) {
   ASSERT_EQ(st.size(), 2u);
   EXPECT_TRUE(st[0].at("step").is_number_integer());
   EXPECT_TRUE(st[0].at("iterations").is_number_integer());
-  EXPECT_TRUE(st[0].at("residual").is_null());  // NaN
+  EXPECT_TRUE(st[0].at("residual").is_null());            // NaN
   EXPECT_TRUE(st[1].at("max_bending_moment").is_null());  // inf
   EXPECT_DOUBLE_EQ(st[1].at("residual").get<double>(), 1e-9);
   EXPECT_FALSE(st[0].contains("distal_diameter"));
@@ -87,8 +88,8 @@ TEST(BeamSummary, NonFiniteIsNullAndStringsRoundTrip) {
   const auto ordered = nlohmann::ordered_json::parse(text);
   std::vector<std::string> keys;
   for (const auto& [k, v] : ordered.at("steps")[0].items()) keys.push_back(k);
-  EXPECT_EQ(keys, (std::vector<std::string>{"step", "time", "diameter", "iterations", "residual",
-                                            "max_bending_moment", "wall_seconds"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"step", "time", "diameter", "iterations", "residual", "max_bending_moment",
+                                            "wall_seconds"}));
 
   const auto& x = j.at("final_positions");
   ASSERT_EQ(x.size(), 3u);
@@ -112,7 +113,8 @@ TEST(BeamSummary, GeneratedStentBlock) {
   StepRecord initial = record(0, 0.0, 1.5);
   initial.length = 10.0;
   initial.axis_sagitta = 0.0;
-  const auto path = std::filesystem::temp_directory_path() / ("beam_summary_stent_json_test_" + std::to_string(::getpid()) + ".json");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("beam_summary_stent_json_test_" + std::to_string(::getpid()) + ".json");
   const auto j = nlohmann::json::parse(write_summary(path.string(), m, steps, true, "completed", 1.0, 0, initial));
   std::filesystem::remove(path);
   const auto& s = j.at("stent");

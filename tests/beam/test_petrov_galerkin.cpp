@@ -42,16 +42,16 @@ struct State {
   Quat R1, R2;
 };
 
-Vec12 residual(ResidualForm f, const Section& s, const ElementReference& ref, const State& c,
-               const PlasticState& st, const Vec12& d = Vec12::Zero()) {
+Vec12 residual(ResidualForm f, const Section& s, const ElementReference& ref, const State& c, const PlasticState& st,
+               const Vec12& d = Vec12::Zero()) {
   const Vec3 x1 = c.x1 + d.segment<3>(0), x2 = c.x2 + d.segment<3>(6);
   const Quat R1 = quat_exp(d.segment<3>(3)) * c.R1, R2 = quat_exp(d.segment<3>(9)) * c.R2;
   return evaluate_element(s, ref, x1, x2, R1, R2, st, false, f).residual;
 }
 
 // Central differences of the residual w.r.t. (Δx, Δθ), Λ ← exp(Δθ)Λ.
-Mat12 fd_tangent(ResidualForm f, const Section& s, const ElementReference& ref, const State& c,
-                 const PlasticState& st, double h) {
+Mat12 fd_tangent(ResidualForm f, const Section& s, const ElementReference& ref, const State& c, const PlasticState& st,
+                 double h) {
   Mat12 K;
   for (int i = 0; i < 12; ++i) {
     Vec12 d = Vec12::Zero();
@@ -96,9 +96,9 @@ double rel_diff(const Vec12& a, const Vec12& b) { return (a - b).norm() / b.norm
 TEST(BeamPetrovGalerkin, TangentMatchesFiniteDifferencesPlastic) {
   const Section s = paper_section();
   const Vec3 t(1, 0.2, 0.1);
-  const ElementReference ref = make_element_reference(
-      Vec3::Zero(), t, triad_from_tangent(t, Vec3::UnitZ()),
-      triad_from_tangent(Vec3(1, 0.3, 0.05), Vec3::UnitZ()));  // curved: Ω0 ≠ 0
+  const ElementReference ref =
+      make_element_reference(Vec3::Zero(), t, triad_from_tangent(t, Vec3::UnitZ()),
+                             triad_from_tangent(Vec3(1, 0.3, 0.05), Vec3::UnitZ()));  // curved: Ω0 ≠ 0
   State c;
   c.x1 = Vec3(0.01, -0.02, 0.03);
   c.x2 = Vec3(0.98, 0.28, 0.09);
@@ -131,9 +131,8 @@ TEST(BeamPetrovGalerkin, TangentMatchesFiniteDifferencesPlastic) {
 TEST(BeamPetrovGalerkin, TangentMatchesFiniteDifferencesElastic) {
   const Section s = circular_section(1000.0, 0.3, 0.1);
   const Vec3 t(1, 0.2, 0.1);
-  const ElementReference ref = make_element_reference(
-      Vec3::Zero(), t, triad_from_tangent(t, Vec3::UnitZ()),
-      triad_from_tangent(Vec3(1, 0.25, 0.05), Vec3::UnitZ()));
+  const ElementReference ref = make_element_reference(Vec3::Zero(), t, triad_from_tangent(t, Vec3::UnitZ()),
+                                                      triad_from_tangent(Vec3(1, 0.25, 0.05), Vec3::UnitZ()));
   State c;
   c.x1 = Vec3(0.01, -0.02, 0.03);
   c.x2 = Vec3(0.9, 0.35, -0.2);
@@ -161,9 +160,9 @@ TEST(BeamPetrovGalerkin, AgreesWithConsistentWhenMomentParallelToRelativeRotatio
   {
     const Section s = paper_section();
     const Vec3 t(0.4, 0.05, 0);
-    const ElementReference ref = make_element_reference(
-        Vec3::Zero(), t, triad_from_tangent(t, Vec3::UnitY()),
-        triad_from_tangent(Vec3(0.4, 0.1, 0), Vec3::UnitY()));  // curved in the x–y plane
+    const ElementReference ref =
+        make_element_reference(Vec3::Zero(), t, triad_from_tangent(t, Vec3::UnitY()),
+                               triad_from_tangent(Vec3(0.4, 0.1, 0), Vec3::UnitY()));  // curved in the x–y plane
     State c;
     c.x1 = Vec3(0.02, 0.01, 0);
     c.x2 = Vec3(0.37, 0.21, 0);
@@ -241,8 +240,8 @@ TEST(BeamPetrovGalerkin, ShearTermDiffersAtFirstOrder) {
     const Vec3 n = rc.segment<3>(6), d = c.x2 - c.x1;
     const Vec3 lead = 0.125 * phi_s.cross(d.cross(n));
     const double e = diff.norm();
-    std::printf("shear: |phi| %.3f  |r_PG − r_C| %.3e  ratio %.3f  |diff_θ1 + lead|/|lead| %.2e\n",
-                phi_s.norm(), e, prev > 0 ? prev / e : 0.0, (diff.segment<3>(3) + lead).norm() / lead.norm());
+    std::printf("shear: |phi| %.3f  |r_PG − r_C| %.3e  ratio %.3f  |diff_θ1 + lead|/|lead| %.2e\n", phi_s.norm(), e,
+                prev > 0 ? prev / e : 0.0, (diff.segment<3>(3) + lead).norm() / lead.norm());
     if (sc < 0.15) {
       EXPECT_NEAR(prev / e, 2.0, 0.1);
     }
@@ -270,8 +269,7 @@ CantileverResult plastic_cantilever(int ne, ResidualForm form, const std::string
   for (int i = 0; i <= ne; ++i) m.add_node(Vec3(L * i / ne, 0, 0));
   for (int i = 0; i < ne; ++i) m.add_element(i, i + 1, sec, Vec3::UnitY());
   m.fix(0, {true, true, true, true, true, true});
-  m.nodal_loads.push_back(
-      {ne, Vec3::Zero(), Vec3(0.12, 0, 0.24), [](double t) { return t <= 1 ? t : 2 - t; }});
+  m.nodal_loads.push_back({ne, Vec3::Zero(), Vec3(0.12, 0, 0.24), [](double t) { return t <= 1 ? t : 2 - t; }});
   m.residual_form = form;
   m.newton.linear_solver = solver;
   m.newton.residual_tol = 1e-11;
@@ -309,24 +307,27 @@ TEST(BeamPetrovGalerkin, PlasticCantileverRefinementBothFormsConverge) {
     rp[i] = plastic_cantilever(nes[i], kPG);
     EXPECT_LE(rp[i].max_iterations, rc[i].max_iterations + 2);  // Newton rate kept (exact tangent)
   }
-  std::printf("ne | form | tip at peak (mm) | tip rotation at peak (rad) | tip after unloading | "
-              "rotation after unloading | max Newton its\n");
+  std::printf(
+      "ne | form | tip at peak (mm) | tip rotation at peak (rad) | tip after unloading | "
+      "rotation after unloading | max Newton its\n");
   for (int i = 0; i < 5; ++i)
     for (int f = 0; f < 2; ++f) {
       const CantileverResult& r = f ? rp[i] : rc[i];
-      std::printf("%2d | %s | %.6f %.6f %.6f | %.6f %.6f %.6f | %.6f %.6f %.6f | %.6f %.6f %.6f | %d\n",
-                  nes[i], f ? "PG" : "C ", r.tip_peak.x(), r.tip_peak.y(), r.tip_peak.z(),
-                  r.rot_peak.x(), r.rot_peak.y(), r.rot_peak.z(), r.tip_final.x(), r.tip_final.y(),
-                  r.tip_final.z(), r.rot_final.x(), r.rot_final.y(), r.rot_final.z(), r.max_iterations);
+      std::printf("%2d | %s | %.6f %.6f %.6f | %.6f %.6f %.6f | %.6f %.6f %.6f | %.6f %.6f %.6f | %d\n", nes[i],
+                  f ? "PG" : "C ", r.tip_peak.x(), r.tip_peak.y(), r.tip_peak.z(), r.rot_peak.x(), r.rot_peak.y(),
+                  r.rot_peak.z(), r.tip_final.x(), r.tip_final.y(), r.tip_final.z(), r.rot_final.x(), r.rot_final.y(),
+                  r.rot_final.z(), r.max_iterations);
     }
   // Reference: Richardson extrapolation of each form from 32 and 64 elements (second order).
   const Vec3 lim_c = (4.0 * rc[4].tip_peak - rc[3].tip_peak) / 3.0;
   const Vec3 lim_p = (4.0 * rp[4].tip_peak - rp[3].tip_peak) / 3.0;
-  std::printf("Richardson limits of the tip at peak: C %.7f %.7f %.7f, PG %.7f %.7f %.7f, "
-              "|difference| %.2e\n", lim_c.x(), lim_c.y(), lim_c.z(), lim_p.x(), lim_p.y(), lim_p.z(),
-              (lim_p - lim_c).norm());
-  std::printf("ne | |tip_C − lim_C| | order | |tip_PG − lim_C| | order | |tip_PG − tip_C| (peak) | order | "
-              "|rot_PG − rot_C| (peak) | |tip_PG − tip_C| (unloaded) | order\n");
+  std::printf(
+      "Richardson limits of the tip at peak: C %.7f %.7f %.7f, PG %.7f %.7f %.7f, "
+      "|difference| %.2e\n",
+      lim_c.x(), lim_c.y(), lim_c.z(), lim_p.x(), lim_p.y(), lim_p.z(), (lim_p - lim_c).norm());
+  std::printf(
+      "ne | |tip_C − lim_C| | order | |tip_PG − lim_C| | order | |tip_PG − tip_C| (peak) | order | "
+      "|rot_PG − rot_C| (peak) | |tip_PG − tip_C| (unloaded) | order\n");
   double cprev = 0, pprev = 0, dprev = 0, uprev = 0;
   auto order = [](double a, double b) { return a > 0 ? std::log2(a / b) : 0.0; };
   for (int i = 0; i < 5; ++i) {
@@ -335,8 +336,8 @@ TEST(BeamPetrovGalerkin, PlasticCantileverRefinementBothFormsConverge) {
     const double d = (rp[i].tip_peak - rc[i].tip_peak).norm();
     const double dr = (rp[i].rot_peak - rc[i].rot_peak).norm();
     const double u = (rp[i].tip_final - rc[i].tip_final).norm();
-    std::printf("%2d | %.3e | %.2f | %.3e | %.2f | %.3e | %.2f | %.3e | %.3e | %.2f\n", nes[i], ec,
-                order(cprev, ec), ep, order(pprev, ep), d, order(dprev, d), dr, u, order(uprev, u));
+    std::printf("%2d | %.3e | %.2f | %.3e | %.2f | %.3e | %.2f | %.3e | %.3e | %.2f\n", nes[i], ec, order(cprev, ec),
+                ep, order(pprev, ep), d, order(dprev, d), dr, u, order(uprev, u));
     if (i > 0) {
       EXPECT_GT(cprev / ec, 3.5) << "ne " << nes[i];  // second order: ≈ 4
       EXPECT_GT(pprev / ep, 3.5) << "ne " << nes[i];
@@ -366,7 +367,8 @@ TEST(BeamPetrovGalerkin, LuBackendsSolveNonSymmetricTangent) {
 namespace {
 std::string scene_text(const std::string& element) {
   return "time: {end: 1, steps: 2}\nstent:\n  material: {E: 5, nu: 0.3}\n  section: {radius: 0.06}\n"
-         "  lines: [{from: [0,0,0], to: [1,0,0], elements: 2}]\n" + element;
+         "  lines: [{from: [0,0,0], to: [1,0,0], elements: 2}]\n" +
+         element;
 }
 // Loads a scene text; returns the model's residual form, or the SceneError message in `err`.
 ResidualForm load_form(const std::string& text, std::string* err) {

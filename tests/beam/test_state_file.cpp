@@ -31,7 +31,8 @@ std::string scene_text() {
 // The scene with its time line replaced and `initial` (an initial_state entry) added to the stent.
 BeamScene scene(const std::string& time, const std::string& initial = "") {
   std::string t = std::regex_replace(scene_text(), std::regex("time: \\{[^}]*\\}"), time);
-  if (!initial.empty()) t = std::regex_replace(t, std::regex("\nstent:\n"), "\nstent:\n  initial_state: " + initial + "\n");
+  if (!initial.empty())
+    t = std::regex_replace(t, std::regex("\nstent:\n"), "\nstent:\n  initial_state: " + initial + "\n");
   std::filesystem::create_directories(kDir);
   const auto path = kDir / "scene.yaml";
   std::ofstream(path) << t;

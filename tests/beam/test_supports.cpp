@@ -174,7 +174,7 @@ TEST(BeamSupports, AssembledTangentWithContactPlanesMatchesFiniteDifferences) {
     planes[g].s = m.sample_position(g) - (0.06 + (g % 2 ? 0.02 : -0.01)) * planes[g].n;
     planes[g].eps = 10.0;
     planes[g].g0 = g < 12 ? 0.0 : 0.015;  // linear law, and the linear-quadratic law whose
-    active += g % 2;                       // quadratic zone holds the points 0.01 mm off
+    active += g % 2;                      // quadratic zone holds the points 0.01 mm off
   }
   m.set_sample_planes(planes);
   Eigen::VectorXd d = Eigen::VectorXd::LinSpaced(m.num_free_dofs(), -1e-4, 2e-4);

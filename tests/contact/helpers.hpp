@@ -59,11 +59,11 @@ inline Mesh cylinder(FaceKind kind, double R, double L, int nt, int nz, double t
       } else {
         f.kind = FaceKind::Tri6;
         // (i,j) -> (i+1,j) -> (i+1,j+1)
-        f.nodes = {id(i, j), id(i + 1, j), id(i + 1, j + 1), mid(i + 0.5, j), mid(i + 1, j + 0.5),
-                   mid(i + 0.5, j + 0.5)};
+        f.nodes = {id(i, j),        id(i + 1, j),        id(i + 1, j + 1),
+                   mid(i + 0.5, j), mid(i + 1, j + 0.5), mid(i + 0.5, j + 0.5)};
         m.surface.faces.push_back(f);
         // (i,j) -> (i+1,j+1) -> (i,j+1)
-        f.nodes = {id(i, j), id(i + 1, j + 1), id(i, j + 1), mid(i + 0.5, j + 0.5), mid(i + 0.5, j + 1),
+        f.nodes = {id(i, j),       id(i + 1, j + 1), id(i, j + 1), mid(i + 0.5, j + 0.5), mid(i + 0.5, j + 1),
                    mid(i, j + 0.5)};
         m.surface.faces.push_back(f);
       }
@@ -129,8 +129,8 @@ inline double brute_distance(FaceKind k, const FaceX& X, const Vec3& x, Vec2* be
   double step = 2.0 / n;
   while (step > 1e-13) {
     bool improved = false;
-    for (const Vec2& dir : {Vec2(1, 0), Vec2(-1, 0), Vec2(0, 1), Vec2(0, -1), Vec2(1, 1), Vec2(-1, -1), Vec2(1, -1),
-                            Vec2(-1, 1)}) {
+    for (const Vec2& dir :
+         {Vec2(1, 0), Vec2(-1, 0), Vec2(0, 1), Vec2(0, -1), Vec2(1, 1), Vec2(-1, -1), Vec2(1, -1), Vec2(-1, 1)}) {
       const Vec2 c = clampd(bx + step * dir);
       const double d = dist(c);
       if (d < bd) {
@@ -169,8 +169,7 @@ inline FaceX cylinder_tri6(double Rc = 1.0) {
 }
 
 // Sums per-face contact contributions into a dense residual (and tangent if K is given) over n nodes.
-inline Eigen::VectorXd assemble_dense(const std::vector<NodalContribution>& contributions, int n,
-                                      Eigen::MatrixXd* K) {
+inline Eigen::VectorXd assemble_dense(const std::vector<NodalContribution>& contributions, int n, Eigen::MatrixXd* K) {
   Eigen::VectorXd r = Eigen::VectorXd::Zero(3 * n);
   if (K) K->setZero(3 * n, 3 * n);
   for (const NodalContribution& c : contributions)
@@ -185,8 +184,9 @@ inline Eigen::VectorXd assemble_dense(const std::vector<NodalContribution>& cont
 
 // Checks an assembly r(u) (K: its tangent if non-null; `energy`: set by each call to the penalty potential)
 // by central differences with step 1e-6: K = dr/du and r = dPi/du, both to 1e-6 relative. r: the residual at u.
-inline void expect_fd_consistent(const std::function<Eigen::VectorXd(const Eigen::VectorXd&, Eigen::MatrixXd*)>& assemble,
-                                 const double& energy, const Eigen::VectorXd& u, Eigen::VectorXd& r) {
+inline void expect_fd_consistent(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&, Eigen::MatrixXd*)>& assemble, const double& energy,
+    const Eigen::VectorXd& u, Eigen::VectorXd& r) {
   Eigen::MatrixXd K;
   r = assemble(u, &K);
   ASSERT_GT(r.norm(), 0.0);

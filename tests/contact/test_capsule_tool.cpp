@@ -32,7 +32,7 @@ TEST(CapsuleTool, DistanceToAPolyline) {
   const AxisDistance in = polyline_distance(axis, Vec3(0.3, 0.4, 1.0));  // beside the first segment
   EXPECT_NEAR(in.r, 0.5, 1e-14);
   EXPECT_NEAR((in.foot - Vec3(0, 0, 1)).norm(), 0.0, 1e-14);
-  EXPECT_NEAR(in.P(2, 2), 0.0, 1e-14);  // no change of r along the axis
+  EXPECT_NEAR(in.P(2, 2), 0.0, 1e-14);                                   // no change of r along the axis
   const AxisDistance end = polyline_distance(axis, Vec3(0, 0.6, -0.8));  // beyond the first end: a sphere
   EXPECT_NEAR(end.r, 1.0, 1e-14);
   EXPECT_TRUE(end.P.isIdentity(1e-14));
@@ -41,10 +41,10 @@ TEST(CapsuleTool, DistanceToAPolyline) {
 TEST(CapsuleTool, PenaltyDerivativesByFiniteDifferences) {
   const std::vector<Vec3> axis = {Vec3(0, 0, 0), Vec3(0, 0, 2), Vec3(1, 0, 3)};
   const double R = 0.7, eps_area = 3.0;
-  check_fd(axis, Vec3(0.3, 0.2, 1.0), R, eps_area);    // inside the first segment's cylinder
-  check_fd(axis, Vec3(0.4, 0.35, 2.5), R, eps_area);   // beside the second, oblique segment
-  check_fd(axis, Vec3(0.1, 0.2, -0.3), R, eps_area);   // the rounded end
-  check_fd(axis, Vec3(-0.3, 0.1, 2.1), R, eps_area);   // the outer corner at the bend (vertex)
+  check_fd(axis, Vec3(0.3, 0.2, 1.0), R, eps_area);   // inside the first segment's cylinder
+  check_fd(axis, Vec3(0.4, 0.35, 2.5), R, eps_area);  // beside the second, oblique segment
+  check_fd(axis, Vec3(0.1, 0.2, -0.3), R, eps_area);  // the rounded end
+  check_fd(axis, Vec3(-0.3, 0.1, 2.1), R, eps_area);  // the outer corner at the bend (vertex)
 }
 
 TEST(CapsuleTool, NoForceOutsideAndOutwardInside) {

@@ -9,8 +9,7 @@ using namespace angio::contact::test;
 
 namespace {
 // FD check of the solid tangent: K = d r / dX with the beam point fixed (r = dPi/dX = -forces).
-void check_tangent(FaceKind k, const FaceX& X, double sign, const BeamPoint& bp, double eps = 10.0,
-                   double g0 = 0.0) {
+void check_tangent(FaceKind k, const FaceX& X, double sign, const BeamPoint& bp, double eps = 10.0, double g0 = 0.0) {
   LineContactParams par;
   par.penalty = eps;
   par.regularization = g0;
@@ -68,9 +67,8 @@ TEST(LineContact, PointPressedIntoFlatQuad) {
   EXPECT_TRUE(pc.active);
   EXPECT_NEAR(pc.gap, -pen, 1e-15);
   EXPECT_NEAR((pc.q - Vec3(0, 0, eps * pen)).norm(), 0, 1e-14);  // beam pushed along +n
-  const double N[4] = {0.375, 0.125, 0.125, 0.375};                // bilinear N at (0.25, 0.5)
-  for (int a = 0; a < 4; ++a)
-    EXPECT_NEAR((-r.segment<3>(3 * a) - Vec3(0, 0, -eps * pen * w * N[a])).norm(), 0, 1e-15);
+  const double N[4] = {0.375, 0.125, 0.125, 0.375};              // bilinear N at (0.25, 0.5)
+  for (int a = 0; a < 4; ++a) EXPECT_NEAR((-r.segment<3>(3 * a) - Vec3(0, 0, -eps * pen * w * N[a])).norm(), 0, 1e-15);
   check_tangent(FaceKind::Quad4, X, 1.0, bp, eps);
   // separated point: no force
   bp.x.z() = R + 0.001;
@@ -170,7 +168,8 @@ TEST(LineContact, SlidingAcrossFaceBoundariesContinuousGap) {
   int changes = 0;
   {  // coplanar quads: gap constant
     Mesh m = flat_quads(2, 1, 1.0, 1.0);
-    const double slope = run(m, [](double t) { return Vec3(t, 0.4, 0.05); }, 0.2, 1.8, changes);
+    const double slope = run(
+        m, [](double t) { return Vec3(t, 0.4, 0.05); }, 0.2, 1.8, changes);
     EXPECT_LT(slope, 1e-9);
     EXPECT_GE(changes, 1);
     EXPECT_LT(normal_jump, 1e-12);
@@ -180,7 +179,8 @@ TEST(LineContact, SlidingAcrossFaceBoundariesContinuousGap) {
     const double a = 20 * M_PI / 180;
     for (Vec3& p : m.x)
       if (p.x() > 1.5) p = Vec3(1 + std::cos(a), p.y(), -std::sin(a));
-    const double slope = run(m, [](double t) { return Vec3(t, 0.4, 0.04); }, 0.5, 1.5, changes);
+    const double slope = run(
+        m, [](double t) { return Vec3(t, 0.4, 0.04); }, 0.5, 1.5, changes);
     EXPECT_LT(slope, 1.0 + 1e-6);  // |dg/dx| <= 1 for a distance function
     EXPECT_GE(changes, 1);
     // the point-to-edge normal turns continuously over the kink: rate <= 1/height per unit path length
@@ -188,12 +188,14 @@ TEST(LineContact, SlidingAcrossFaceBoundariesContinuousGap) {
   }
   {  // tri6 cylinder: circumferential path crossing quad-diagonal and element edges, outside the balloon
     Mesh m = cylinder(FaceKind::Tri6, 0.5, 1.0, 12, 2);
-    const double slope = run(m, [](double t) { return cyl(0.55, t, 0.3 + 0.1 * t); }, 0.1, 2.0, changes);
+    const double slope = run(
+        m, [](double t) { return cyl(0.55, t, 0.3 + 0.1 * t); }, 0.1, 2.0, changes);
     EXPECT_LT(slope, 0.2);
     EXPECT_GE(changes, 3);
     // from inside (lumen-like view with normal_sign = -1)
     m.surface.normal_sign = -1.0;
-    const double slope2 = run(m, [](double t) { return cyl(0.45, t, 0.3 + 0.1 * t); }, 0.1, 2.0, changes);
+    const double slope2 = run(
+        m, [](double t) { return cyl(0.45, t, 0.3 + 0.1 * t); }, 0.1, 2.0, changes);
     EXPECT_LT(slope2, 0.2);
   }
 }
@@ -225,11 +227,11 @@ TEST(LineContact, TwoSurfacesSum) {
   const auto ra = evaluate_line_contact(pts, only_a, par);
   const auto r2 = evaluate_line_contact(pts, both, par);
   EXPECT_LT((r2.q[0] - rb.q[0] - ra.q[0]).norm(), 1e-14);
-  EXPECT_EQ(r2.diag.num_active, 3);  // point 0 touches both surfaces, point 1 only the artery
+  EXPECT_EQ(r2.diag.num_active, 3);                         // point 0 touches both surfaces, point 1 only the artery
   EXPECT_GT(rb.q[0].dot(cyl(1, th, 0).normalized()), 0.0);  // balloon pushes outward
   EXPECT_LT(ra.q[0].dot(cyl(1, th, 0).normalized()), 0.0);  // artery pushes inward
-  EXPECT_NEAR(rb.q[0].norm(), 10.0 * (R - 0.05), 1e-9);       // faceted balloon: exact at the node line
-  EXPECT_NEAR(ra.q[0].norm(), 10.0 * (R - 0.05), 1e-2);       // tri6 artery: ~1e-4 mm geometric error
+  EXPECT_NEAR(rb.q[0].norm(), 10.0 * (R - 0.05), 1e-9);     // faceted balloon: exact at the node line
+  EXPECT_NEAR(ra.q[0].norm(), 10.0 * (R - 0.05), 1e-2);     // tri6 artery: ~1e-4 mm geometric error
   EXPECT_TRUE(r2.per_surface[1][1].found);  // second point: inside the artery wall by 0.1 - R (penetrates)
   EXPECT_TRUE(r2.per_surface[1][1].active);
   EXPECT_FALSE(r2.per_surface[0][1].active);
@@ -291,7 +293,7 @@ TEST(LineContact, LinearQuadraticLawMatchesClosedFormAndTangents) {
   EXPECT_NEAR(force(-0.01), eps * (0.5 * g0 + 0.01), 1e-14);
   EXPECT_NEAR(force(0.001), 0.5 * eps * (g0 - 0.001) * (g0 - 0.001) / g0, 1e-15);
   EXPECT_EQ(force(g0 + 1e-6), 0.0);
-  EXPECT_NEAR(force(-1e-9), force(1e-9), 1e-7);            // continuous at g = 0
+  EXPECT_NEAR(force(-1e-9), force(1e-9), 1e-7);  // continuous at g = 0
   // stiffness continuous at 0 (one-sided slopes −eps and −eps (1 − h/g0): difference O(eps h/g0))
   EXPECT_NEAR((force(1e-7) - force(-1e-7)) / 2e-7, -eps, 1e-3);
   check_tangent(FaceKind::Quad4, X, 1.0, BeamPoint{Vec3(0.3, 0.6, R - 0.01), w, R}, eps, g0);

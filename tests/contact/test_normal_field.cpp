@@ -11,7 +11,8 @@ namespace {
 FaceX tilted_normals(FaceKind k, const FaceX& X) {
   FaceX Nn(3, num_nodes(k));
   const Vec3 c = evaluate(k, X, center_xi(k)).n;
-  for (int a = 0; a < Nn.cols(); ++a) Nn.col(a) = (c + 0.15 * Vec3(std::sin(1.0 + a), std::cos(2.0 * a), 0.3 * a - 0.4)).normalized();
+  for (int a = 0; a < Nn.cols(); ++a)
+    Nn.col(a) = (c + 0.15 * Vec3(std::sin(1.0 + a), std::cos(2.0 * a), 0.3 * a - 0.4)).normalized();
   return Nn;
 }
 

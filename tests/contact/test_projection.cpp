@@ -85,7 +85,8 @@ TEST(Projection, CurvedFacesMatchBruteForce) {
   for (const Case& c : cases) {
     for (int trial = 0; trial < 60; ++trial) {
       // parameter point possibly outside the domain (near edges/corners), then offset along the normal
-      Vec2 xi = c.k == FaceKind::Quad4 ? Vec2(1.3 * U(rng), 1.3 * U(rng)) : Vec2(0.4 + 0.8 * U(rng), 0.3 + 0.8 * U(rng));
+      Vec2 xi =
+          c.k == FaceKind::Quad4 ? Vec2(1.3 * U(rng), 1.3 * U(rng)) : Vec2(0.4 + 0.8 * U(rng), 0.3 + 0.8 * U(rng));
       const FacePoint fp = evaluate(c.k, c.X, xi);
       const Vec3 x = fp.x + 0.25 * U(rng) * fp.n;
       const Projection p = project(c.k, c.X, 1.0, x);
@@ -194,8 +195,9 @@ TEST(Projection, LinearizationMatchesFiniteDifferences) {
   }
 }
 
-// Compares against: brute-force minimization (dense sampling + pattern search) on randomly distorted quad4/tri3/tri6 faces (strongly warped and
-// curved, non-uniform node spacing) for random points up to half a face size away, on both sides.
+// Compares against: brute-force minimization (dense sampling + pattern search) on randomly distorted quad4/tri3/tri6
+// faces (strongly warped and curved, non-uniform node spacing) for random points up to half a face size away, on both
+// sides.
 #ifndef NFACE
 #define NFACE 12
 #endif
@@ -216,7 +218,8 @@ TEST(Projection, RandomDistortedFacesMatchBruteForce) {
           X.col(3 + m) = 0.5 * (X.col(e[m][0]) + X.col(e[m][1])) + Vec3(0.05 * U(rng), 0.05 * U(rng), 0.15 * U(rng));
       }
       for (int trial = 0; trial < 8; ++trial) {
-        const Vec2 xi = k == FaceKind::Quad4 ? Vec2(1.2 * U(rng), 1.2 * U(rng)) : Vec2(0.4 + 0.6 * U(rng), 0.3 + 0.6 * U(rng));
+        const Vec2 xi =
+            k == FaceKind::Quad4 ? Vec2(1.2 * U(rng), 1.2 * U(rng)) : Vec2(0.4 + 0.6 * U(rng), 0.3 + 0.6 * U(rng));
         const FacePoint fp = evaluate(k, X, xi);
         const Vec3 x = fp.x + 0.5 * U(rng) * fp.n;
         const Projection p = project(k, X, 1.0, x);

@@ -243,7 +243,7 @@ TEST(SurfaceContact, ConcentricTubes) {
 TEST(SurfaceContact, AssembledTangentMatchesFiniteDifferences) {
   Mesh mas = cylinder(FaceKind::Tri6, 1.0, 0.6, 3, 1, 0.0, 0.6);
   Mesh sla = cylinder(FaceKind::Quad4, 1.01, 0.4, 2, 2, 0.1, 0.5);
-  mas.surface.normal_sign = -1.0;                  // master normal into the lumen
+  mas.surface.normal_sign = -1.0;                                       // master normal into the lumen
   for (Face& f : sla.surface.faces) std::swap(f.nodes[1], f.nodes[3]);  // slave normal outward -> flip to face master
   Mesh all = mas;
   const int off = static_cast<int>(all.x.size());
@@ -267,7 +267,8 @@ TEST(SurfaceContact, AssembledTangentMatchesFiniteDifferences) {
   };
   Eigen::VectorXd u(3 * n);
   for (int i = 0; i < n; ++i) u.segment<3>(3 * i) = all.x[i];
-  // tangent = FD Jacobian; the residual is the gradient of the penalty potential Pi = sum W eps/2 <g_N>^2 (current area W)
+  // tangent = FD Jacobian; the residual is the gradient of the penalty potential Pi = sum W eps/2 <g_N>^2 (current area
+  // W)
   Eigen::VectorXd r;
   expect_fd_consistent(assemble, energy, u, r);
   Vec3 tot = Vec3::Zero();

@@ -54,8 +54,7 @@ struct SpringBeam : participant::BeamParticipant {
   }
   // Robin mode: kb (x − x0) = c + plane load, with the plane law of plane_penalty.hpp along x
   // (normal ±e_x), solved in closed form for the active and the inactive branch.
-  participant::SolveStats solve_with_planes(const std::vector<Vec3>& c,
-                                            const participant::ContactPlanes& p) override {
+  participant::SolveStats solve_with_planes(const std::vector<Vec3>& c, const participant::ContactPlanes& p) override {
     participant::SolveStats st = solve(c);
     for (int i = 0; i < n; ++i) {
       if (!(p.eps[i] > 0.0)) continue;
@@ -85,8 +84,8 @@ struct WallSolid : participant::SolidParticipant {
   double s = 1.0;
   void begin_step(int, double t) override { s = x0 + (s_max - x0) * t; }
   std::vector<double> tolerances;  // of every solve request (the wall is solved exactly anyway)
-  participant::SolveStats solve(const participant::SamplePoints& p,
-                                participant::ContactReply& reply, double tolerance) override {
+  participant::SolveStats solve(const participant::SamplePoints& p, participant::ContactReply& reply,
+                                double tolerance) override {
     tolerances.push_back(tolerance);
     reply = {};
     for (std::size_t i = 0; i < p.size(); ++i) {

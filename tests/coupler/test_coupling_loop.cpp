@@ -24,8 +24,8 @@ std::vector<coupler::StepReport> run_ramp(test::SpringBeam& beam, test::WallSoli
                                           const coupler::CouplingSettings& s, coupler::Acceleration& acc,
                                           coupler::RunReport* run = nullptr) {
   std::vector<coupler::StepReport> reports;
-  const coupler::RunReport r =
-      coupler::run_coupled(beam, wall, ramp(steps), s, acc, [&](const coupler::StepReport& rep) { reports.push_back(rep); });
+  const coupler::RunReport r = coupler::run_coupled(beam, wall, ramp(steps), s, acc,
+                                                    [&](const coupler::StepReport& rep) { reports.push_back(rep); });
   if (run) *run = r;
   return reports;
 }
@@ -55,8 +55,7 @@ TEST(CouplingLoop, ConvergesToAnalyticFixedPointWithAitken) {
   // is flat), so it needs many iterations. Once the active set is fixed the map is linear and
   // Aitken's secant step is exact after two residuals; the extrapolated prediction then makes
   // later steps converge at once.
-  for (std::size_t i = 1; i < reports.size(); ++i)
-    EXPECT_LE(reports[i].iterations, 3) << "step " << reports[i].step;
+  for (std::size_t i = 1; i < reports.size(); ++i) EXPECT_LE(reports[i].iterations, 3) << "step " << reports[i].step;
 }
 
 TEST(CouplingLoop, PlainGaussSeidelFailsOnStiffContact) {
@@ -143,8 +142,7 @@ TEST(CouplingLoop, RobinSchemeReachesTheSameFixedPointWithExactPlanes) {
   // exact for this linear plane map (≤ 3 iterations). From step 3 on the plane offset is
   // extrapolated from two accepted steps, which is exact for the linear wall ramp: 1 iteration.
   EXPECT_LE(reports[1].iterations, 3);
-  for (std::size_t i = 2; i < reports.size(); ++i)
-    EXPECT_EQ(reports[i].iterations, 1) << "step " << reports[i].step;
+  for (std::size_t i = 2; i < reports.size(); ++i) EXPECT_EQ(reports[i].iterations, 1) << "step " << reports[i].step;
 }
 
 TEST(CouplingLoop, RobinSchemeNeedsABeamThatTakesPlanes) {
@@ -246,7 +244,8 @@ TEST(CouplingLoop, InexactSolidToleranceFollowsTheCouplingResidual) {
       for (std::size_t k = 0; k < rep.residuals.size(); ++k, ++solve) {
         ASSERT_LT(solve, wall.tolerances.size());
         const double expected = eta * 0.1 * (k == 0 ? previous_first : rep.residuals[k - 1]);
-        EXPECT_NEAR(wall.tolerances[solve], expected, 1e-14 + 1e-12 * expected) << "step " << rep.step << " iteration " << k;
+        EXPECT_NEAR(wall.tolerances[solve], expected, 1e-14 + 1e-12 * expected)
+            << "step " << rep.step << " iteration " << k;
       }
       previous_first = rep.residuals[0];
     }

@@ -33,8 +33,8 @@ struct LinearMap {
 };
 
 // Runs one step; returns the number of updates until ||r|| <= tol (or -1 after max_updates).
-int run_step(angio::coupler::Acceleration& acc, const LinearMap& m, const Eigen::VectorXd& b,
-             Eigen::VectorXd& q, int max_updates, double tol = 1e-10) {
+int run_step(angio::coupler::Acceleration& acc, const LinearMap& m, const Eigen::VectorXd& b, Eigen::VectorXd& q,
+             int max_updates, double tol = 1e-10) {
   acc.begin_step();
   for (int k = 0; k <= max_updates; ++k) {
     const Eigen::VectorXd r = m.A * q + b - q;

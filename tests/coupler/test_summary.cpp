@@ -26,7 +26,8 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
   r.beam_time = 1.5;
   r.solid_time = 5.0;
   const std::string error = "step 5 failed: \"solid\" did not converge\n  at C:\\run\\x\ttab";
-  const auto path = std::filesystem::temp_directory_path() / ("coupling_summary_json_test_" + std::to_string(::getpid()) + ".json");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("coupling_summary_json_test_" + std::to_string(::getpid()) + ".json");
   ASSERT_TRUE(write_coupling_summary(path.string(), "failed", error, r, 0.5));
   std::ifstream f(path);
   std::stringstream s;
@@ -38,8 +39,8 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
 
   EXPECT_EQ(j.at("status"), "failed");
   EXPECT_EQ(j.at("error").get<std::string>(), error);
-  for (const char* k : {"steps", "rejected_attempts", "prediction_retries", "coupling_iterations_total",
-                        "coupling_iterations_max"})
+  for (const char* k :
+       {"steps", "rejected_attempts", "prediction_retries", "coupling_iterations_total", "coupling_iterations_max"})
     EXPECT_TRUE(j.at(k).is_number_integer()) << k;
   EXPECT_EQ(j.at("steps").get<int>(), 4);
   EXPECT_EQ(j.at("rejected_attempts").get<int>(), 2);
@@ -56,8 +57,8 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
   for (const auto& [k, v] : j.items()) keys.push_back(k);
   EXPECT_EQ(keys, (std::vector<std::string>{"status", "error", "steps", "rejected_attempts", "prediction_retries",
                                             "coupling_iterations_total", "coupling_iterations_mean",
-                                            "coupling_iterations_max", "wall_time", "beam_time",
-                                            "solid_time", "messaging_time", "messaging_share"}));
+                                            "coupling_iterations_max", "wall_time", "beam_time", "solid_time",
+                                            "messaging_time", "messaging_share"}));
 }
 
 TEST(CouplingSummary, OkRunAndNonFiniteTimes) {

@@ -53,7 +53,7 @@ double polyline_length(const std::vector<Vec3>& p) {
 // the straight length within the O(h²) chord error of the sampling).
 TEST(Centerline, WarpIsAnIsometryAlongTheAxis) {
   const Centerline c(angio::geometry::read_centerline_points(std::string(ANGIO_SOURCE_DIR) +
-                                                              "/configs/centerlines/curved_arc_r15.txt"));
+                                                             "/configs/centerlines/curved_arc_r15.txt"));
   const double z0 = 3.0, z1 = 21.0;  // the curved balloon's 18 mm
   // the warped axis sampled on a fine grid plus the centerline vertices (so that no chord cuts a
   // corner of the polyline) is the centerline piece itself

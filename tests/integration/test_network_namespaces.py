@@ -80,16 +80,35 @@ class NetworkNamespaces(unittest.TestCase):
         build = os.path.dirname(BIN)
         try:
             here = os.path.join(tmp, "one_host")
-            r = subprocess.run(LAUNCH + [SCENE, "--run-dir", here, "--build-dir", build], capture_output=True, text=True)
+            r = subprocess.run(
+                LAUNCH + [SCENE, "--run-dir", here, "--build-dir", build], capture_output=True, text=True
+            )
             self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
             with Namespaces() as ns:
                 # the solid's ranks talk to each other inside their namespace; rank 0 to the coupler over tcp
-                mpirun = "mpirun -n 2 --oversubscribe --bind-to none" + (" --allow-run-as-root" if os.geteuid() == 0 else "")
+                mpirun = "mpirun -n 2 --oversubscribe --bind-to none" + (
+                    " --allow-run-as-root" if os.geteuid() == 0 else ""
+                )
                 apart = os.path.join(tmp, "three_hosts")
-                cmd = ns.exec("c") + LAUNCH + [
-                    SCENE, "--run-dir", apart, "--build-dir", build, "--endpoint", "tcp/10.201.0.1:7447", "--log-level", "debug",
-                    "--beam-cmd", " ".join(ns.exec("b") + [os.path.join(BIN, "beam_solver")]),
-                    "--solid-cmd", " ".join(ns.exec("s") + mpirun.split() + [os.path.join(BIN, "solid_solver")])]
+                cmd = (
+                    ns.exec("c")
+                    + LAUNCH
+                    + [
+                        SCENE,
+                        "--run-dir",
+                        apart,
+                        "--build-dir",
+                        build,
+                        "--endpoint",
+                        "tcp/10.201.0.1:7447",
+                        "--log-level",
+                        "debug",
+                        "--beam-cmd",
+                        " ".join(ns.exec("b") + [os.path.join(BIN, "beam_solver")]),
+                        "--solid-cmd",
+                        " ".join(ns.exec("s") + mpirun.split() + [os.path.join(BIN, "solid_solver")]),
+                    ]
+                )
                 r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
                 self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
             with open(os.path.join(apart, "solid_solver.log")) as f:

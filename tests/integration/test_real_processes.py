@@ -31,8 +31,10 @@ DATA = ROOT / "tests" / "integration" / "data"
 SCENE = DATA / "tiny_coupled.yaml"
 REC = DATA / "tiny_coupled.angiorec"
 LAUNCH = [sys.executable, str(ROOT / "scripts" / "launch.py")]
-MPIRUN = ["mpirun", "-n", "2", "--oversubscribe", "--bind-to", "none"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
-TOL_SOLVER = "1e-6"   # real solvers vs recording: iterative solves, different machines
+MPIRUN = ["mpirun", "-n", "2", "--oversubscribe", "--bind-to", "none"] + (
+    ["--allow-run-as-root"] if os.geteuid() == 0 else []
+)
+TOL_SOLVER = "1e-6"  # real solvers vs recording: iterative solves, different machines
 failures = []
 
 
@@ -50,7 +52,11 @@ with tempfile.TemporaryDirectory() as tmp:
     tmp = Path(tmp)
     # 1. the real chain
     r = run(LAUNCH + [str(SCENE), "--run-dir", str(tmp / "real"), "--build-dir", str(BIN.parent), "--timeout", "120"])
-    check(r.returncode == 0, f"coupler + beam_solver + solid_solver run exits 0 (got {r.returncode})\n{r.stdout[-2000:]}\n{r.stderr[-2000:]}")
+    check(
+        r.returncode == 0,
+        f"coupler + beam_solver + solid_solver run exits 0 (got {r.returncode})\n"
+        f"{r.stdout[-2000:]}\n{r.stderr[-2000:]}",
+    )
     if r.returncode == 0:
         lines = (tmp / "real" / "coupling.csv").read_text().strip().splitlines()
         check(len(lines) == 3, f"two load steps in coupling.csv ({len(lines) - 1})")
@@ -61,7 +67,9 @@ with tempfile.TemporaryDirectory() as tmp:
 
         # 3. continued from the state files of the first step
         import yaml
+
         base = yaml.safe_load(SCENE.read_text())
+
         def variant(name, time, states=None, n_circ=None):
             s = json.loads(json.dumps(base))
             s["time"] = time
@@ -73,29 +81,65 @@ with tempfile.TemporaryDirectory() as tmp:
             path = tmp / f"{name}.yaml"
             path.write_text(yaml.safe_dump(s))
             return path
+
         first = variant("first", {"end": 0.5, "steps": 1})
-        r = run(LAUNCH + [str(first), "--run-dir", str(tmp / "first"), "--build-dir", str(BIN.parent), "--timeout", "120"])
-        check(r.returncode == 0 and (tmp / "first" / "solid" / "state.h5").is_file()
-              and (tmp / "first" / "beam" / "state.h5").is_file(), f"first step writes both state files (rc {r.returncode})")
+        r = run(
+            LAUNCH + [str(first), "--run-dir", str(tmp / "first"), "--build-dir", str(BIN.parent), "--timeout", "120"]
+        )
+        check(
+            r.returncode == 0
+            and (tmp / "first" / "solid" / "state.h5").is_file()
+            and (tmp / "first" / "beam" / "state.h5").is_file(),
+            f"first step writes both state files (rc {r.returncode})",
+        )
         # the scene itself resumed from the first step's states (launch.py --resume writes the continued
         # scene: time.start at the states' time, the steps left, both initial_state keys)
         scene_copy = tmp / "tiny_coupled.yaml"
         scene_copy.write_text(SCENE.read_text())
-        r = run(LAUNCH + [str(scene_copy), "--resume", str(tmp / "first"), "--run-dir", str(tmp / "second"),
-                          "--build-dir", str(BIN.parent), "--timeout", "120"])
-        check(r.returncode == 0, f"the continued run exits 0 (rc {r.returncode})\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
+        r = run(
+            LAUNCH
+            + [
+                str(scene_copy),
+                "--resume",
+                str(tmp / "first"),
+                "--run-dir",
+                str(tmp / "second"),
+                "--build-dir",
+                str(BIN.parent),
+                "--timeout",
+                "120",
+            ]
+        )
+        check(
+            r.returncode == 0, f"the continued run exits 0 (rc {r.returncode})\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}"
+        )
         if r.returncode == 0:
             log = (tmp / "second" / "coupler.log").read_text()
-            check("interface state recomputed at t = 0.5 s" in log, "the coupler recomputes the interface state at t = 0.5 s")
-            final = {k: json.loads((tmp / k / "beam" / "summary.json").read_text())["final_positions"] for k in ("real", "first", "second")}
-            dist = lambda a, b: max(math.dist(p, q) for p, q in zip(a, b))
+            check(
+                "interface state recomputed at t = 0.5 s" in log,
+                "the coupler recomputes the interface state at t = 0.5 s",
+            )
+            final = {
+                k: json.loads((tmp / k / "beam" / "summary.json").read_text())["final_positions"]
+                for k in ("real", "first", "second")
+            }
+
+            def dist(a, b):
+                return max(math.dist(p, q) for p, q in zip(a, b))
+
             motion, diff = dist(final["first"], final["real"]), dist(final["second"], final["real"])
             print(f"     stent motion over the second step {motion:.4e} mm, continued - uninterrupted {diff:.3e} mm")
-            check(motion > 1e-3 and diff < 0.01 * motion, "the continued run ends where the uninterrupted run ends (1 % of the step's motion)")
+            check(
+                motion > 1e-3 and diff < 0.01 * motion,
+                "the continued run ends where the uninterrupted run ends (1 % of the step's motion)",
+            )
         other = variant("other_mesh", {"start": 0.5, "end": 1.0, "steps": 1}, tmp / "first", n_circ=16)
         r = run(LAUNCH + [str(other), "--check", "--build-dir", str(BIN.parent)])
-        check(r.returncode == 2 and "solid.initial_state" in r.stdout + r.stderr,
-              f"a state of another mesh: --check exits 2 naming solid.initial_state (rc {r.returncode})\n{r.stderr[-800:]}")
+        check(
+            r.returncode == 2 and "solid.initial_state" in r.stdout + r.stderr,
+            f"a state of another mesh: --check exits 2 naming solid.initial_state (rc {r.returncode})\n"
+            f"{r.stderr[-800:]}",
+        )
 
     if REC.is_file():
         # The recorded run id (header: 8-byte magic, u32 format, u32 length + id): the real
@@ -106,10 +150,27 @@ with tempfile.TemporaryDirectory() as tmp:
 
         # 2a. coupler + replay participants
         replay = str(BIN / "replay_participant")
-        r = run(LAUNCH + [str(SCENE), "--run-dir", str(tmp / "replay"), "--build-dir", str(BIN.parent), "--timeout", "60",
-                          "--beam-cmd", f"{replay} --role beam --recording {REC}",
-                          "--solid-cmd", f"{replay} --role solid --recording {REC}"])
-        check(r.returncode == 0, f"(a) coupler + replay participants reproduce the recording (rc {r.returncode})\n{r.stdout[-1500:]}\n{r.stderr[-1500:]}")
+        r = run(
+            LAUNCH
+            + [
+                str(SCENE),
+                "--run-dir",
+                str(tmp / "replay"),
+                "--build-dir",
+                str(BIN.parent),
+                "--timeout",
+                "60",
+                "--beam-cmd",
+                f"{replay} --role beam --recording {REC}",
+                "--solid-cmd",
+                f"{replay} --role solid --recording {REC}",
+            ]
+        )
+        check(
+            r.returncode == 0,
+            f"(a) coupler + replay participants reproduce the recording (rc {r.returncode})\n"
+            f"{r.stdout[-1500:]}\n{r.stderr[-1500:]}",
+        )
 
         # 2b/c. real solvers driven by the recorded requests; driver and solver share one key file
         key = tmp / "drive.key"
@@ -118,16 +179,51 @@ with tempfile.TemporaryDirectory() as tmp:
             f.write(secrets.token_hex(32) + "\n")
         for role, exe in (("beam", [str(BIN / "beam_solver")]), ("solid", MPIRUN + [str(BIN / "solid_solver")])):
             ep = f"unixsock-stream/{tmp}/{role}.sock"
-            driver = subprocess.Popen([str(BIN / "replay_driver"), "--recording", str(REC), "--role", role,
-                                       "--endpoint", ep, "--tolerance", TOL_SOLVER, "--timeout", "120",
-                                       "--key-file", str(key)],
-                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            solver = run(exe + ["--scene", str(SCENE), "--run-dir", str(tmp / f"drive_{role}"), "--endpoint", ep,
-                                "--run-id", rec_id, "--timeout", "60", "--key-file", str(key)], timeout=300)
+            driver = subprocess.Popen(
+                [
+                    str(BIN / "replay_driver"),
+                    "--recording",
+                    str(REC),
+                    "--role",
+                    role,
+                    "--endpoint",
+                    ep,
+                    "--tolerance",
+                    TOL_SOLVER,
+                    "--timeout",
+                    "120",
+                    "--key-file",
+                    str(key),
+                ],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                text=True,
+            )
+            solver = run(
+                exe
+                + [
+                    "--scene",
+                    str(SCENE),
+                    "--run-dir",
+                    str(tmp / f"drive_{role}"),
+                    "--endpoint",
+                    ep,
+                    "--run-id",
+                    rec_id,
+                    "--timeout",
+                    "60",
+                    "--key-file",
+                    str(key),
+                ],
+                timeout=300,
+            )
             out, _ = driver.communicate(timeout=120)
-            check(driver.returncode == 0 and solver.returncode == 0,
-                  f"({'b' if role == 'beam' else 'c'}) real {role} solver reproduces the recorded replies "
-                  f"(driver rc {driver.returncode}, solver rc {solver.returncode})\n{out[-1500:]}\n{solver.stderr[-1500:]}")
+            check(
+                driver.returncode == 0 and solver.returncode == 0,
+                f"({'b' if role == 'beam' else 'c'}) real {role} solver reproduces the recorded replies "
+                f"(driver rc {driver.returncode}, solver rc {solver.returncode})\n"
+                f"{out[-1500:]}\n{solver.stderr[-1500:]}",
+            )
     else:
         check(False, f"{REC} is missing: run scripts/make_recordings.sh")
 

@@ -84,8 +84,8 @@ TEST(Messages, HelloAndControlMessages) {
   EXPECT_FALSE(se.accept());
   const auto& sd = msg::payload_as<fb::Shutdown>(msg::open(msg::shutdown(coupler(3), "done"), "run-A"));
   EXPECT_EQ(sd.reason()->str(), "done");
-  const auto& er = msg::payload_as<fb::Error>(
-      msg::open(msg::error(coupler(4), "no convergence", 5, 2, {1.0, 0.5}), "run-A"));
+  const auto& er =
+      msg::payload_as<fb::Error>(msg::open(msg::error(coupler(4), "no convergence", 5, 2, {1.0, 0.5}), "run-A"));
   EXPECT_EQ(er.message()->str(), "no convergence");
   EXPECT_EQ(er.residual_history()->size(), 2u);
 }
@@ -97,8 +97,7 @@ TEST(Messages, WrongPayloadTypeIsAClearError) {
     msg::payload_as<fb::BeamSolveRequest>(env);
     FAIL() << "no exception";
   } catch (const ProtocolError& e) {
-    EXPECT_NE(std::string(e.what()).find("expected a BeamSolveRequest message, got StepBegin"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("expected a BeamSolveRequest message, got StepBegin"), std::string::npos)
         << e.what();
   }
 }
@@ -136,8 +135,8 @@ TEST(Messages, RejectsWrongIdentifier) {
 TEST(Messages, RejectsOtherProtocolVersion) {
   flatbuffers::FlatBufferBuilder b;
   auto p = fb::CreateAck(b);
-  auto env = fb::CreateEnvelope(b, msg::kProtocolVersion + 1, b.CreateString("run-A"), 1,
-                                fb::Role::Beam, fb::Payload::Ack, p.Union());
+  auto env = fb::CreateEnvelope(b, msg::kProtocolVersion + 1, b.CreateString("run-A"), 1, fb::Role::Beam,
+                                fb::Payload::Ack, p.Union());
   fb::FinishEnvelopeBuffer(b, env);
   std::vector<std::uint8_t> buf(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
   try {

@@ -17,9 +17,7 @@ using namespace angio::scene;
 namespace {
 const std::string kGood = std::string(ANGIO_TEST_DATA) + "/good.yaml";
 
-Node inline_scene(const std::string& text) {
-  return Node(YAML::Load(text), "inline.yaml", "");
-}
+Node inline_scene(const std::string& text) { return Node(YAML::Load(text), "inline.yaml", ""); }
 
 // Runs f, expects a SceneError whose message contains every fragment.
 template <class F>
@@ -46,8 +44,7 @@ TEST(Scene, ReadsValuesWithPaths) {
 
 TEST(Scene, MissingFileAndSyntaxErrors) {
   expect_error([] { load_scene("/nonexistent/scene.yaml"); }, {"/nonexistent/scene.yaml", "no such file"});
-  expect_error([] { load_scene(std::string(ANGIO_TEST_DATA) + "/syntax_error.yaml"); },
-               {"syntax_error.yaml", "line"});
+  expect_error([] { load_scene(std::string(ANGIO_TEST_DATA) + "/syntax_error.yaml"); }, {"syntax_error.yaml", "line"});
 }
 
 TEST(Scene, ErrorsNameFileKeyAndExpectation) {
@@ -57,11 +54,13 @@ TEST(Scene, ErrorsNameFileKeyAndExpectation) {
   expect_error([&] { m.number("nu"); }, {"stent.material.nu", "a number", "'abc'"});
   expect_error([&] { m.number("G"); }, {"stent.material.G", "missing"});
   expect_error([&] { n.child("stent").integer("rings"); }, {"stent.rings", "integer"});
-  expect_error([&] { n.child("stent").choice("kind", {"corrugated_rings", "explicit"}); },
-               {"stent.kind", "'corrugated_rings'", "'tube'"});
+  expect_error(
+      [&] {
+        n.child("stent").choice("kind", {"corrugated_rings", "explicit"});
+      },
+      {"stent.kind", "'corrugated_rings'", "'tube'"});
   expect_error([&] { n.child("stent").vec3("v"); }, {"stent.v", "3 numbers"});
-  expect_error([&] { n.child("stent").check_keys({"material", "rings", "kind"}); },
-               {"stent.v", "unknown key"});
+  expect_error([&] { n.child("stent").check_keys({"material", "rings", "kind"}); }, {"stent.v", "unknown key"});
 }
 
 TEST(Scene, NonFiniteNumbersAreRejected) {
@@ -85,11 +84,9 @@ TEST(Scene, LoadCurvesInterpolateLinearly) {
 TEST(Scene, BadLoadCurvesAreRejected) {
   expect_error([] { load_curves(inline_scene("load_curves: {p: [[0, 0], [0, 1]]}")); },
                {"load_curves.p[1][0]", "larger than the previous"});
-  expect_error([] { load_curves(inline_scene("load_curves: {p: [[0, 0, 1]]}")); },
-               {"load_curves.p[0]", "pair"});
+  expect_error([] { load_curves(inline_scene("load_curves: {p: [[0, 0, 1]]}")); }, {"load_curves.p[0]", "pair"});
   Node n = inline_scene("load_curves: {p: [[0, 0]]}\nload: {curve: q}");
-  expect_error([&] { curve_ref(n.child("load"), "curve", load_curves(n)); },
-               {"load.curve", "'p'", "'q'"});
+  expect_error([&] { curve_ref(n.child("load"), "curve", load_curves(n)); }, {"load.curve", "'p'", "'q'"});
 }
 
 TEST(Scene, TimeSettings) {
@@ -97,22 +94,26 @@ TEST(Scene, TimeSettings) {
   EXPECT_DOUBLE_EQ(t.end, 2.0);
   EXPECT_EQ(t.steps, 100);
   EXPECT_DOUBLE_EQ(t.min_step, 0.02 / 1024.0);
-  expect_error([] { time_settings(inline_scene("time: {end: 1, steps: 0}")); }, {"time.steps", "an integer in 1..1000000"});
+  expect_error([] { time_settings(inline_scene("time: {end: 1, steps: 0}")); },
+               {"time.steps", "an integer in 1..1000000"});
   expect_error([] { time_settings(inline_scene("time: {start: 2, end: 1, steps: 3}")); }, {"time.end"});
   // stops: the load-curve corners strictly inside (start, end), sorted, each once
-  const TimeSettings c = time_settings(inline_scene(
-      "time: {end: 2, steps: 4}\nload_curves: {a: [[0, 0], [1.3, 1], [2, 0]], b: [[-1, 0], [0.5, 1], [1.3, 2], [3, 0]]}"));
+  const TimeSettings c =
+      time_settings(inline_scene("time: {end: 2, steps: 4}\nload_curves: {a: [[0, 0], [1.3, 1], [2, 0]], b: [[-1, 0], "
+                                 "[0.5, 1], [1.3, 2], [3, 0]]}"));
   EXPECT_EQ(c.stops, (std::vector<double>{0.5, 1.3}));
   EXPECT_EQ(c.max_step, 0.0);  // adaptive steps off unless asked for
-  const TimeSettings a = time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 3}}"));
+  const TimeSettings a =
+      time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 3}}"));
   EXPECT_DOUBLE_EQ(a.max_step, 0.1);
   EXPECT_EQ(a.easy_iterations, 3);
   expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.01}}")); },
                {"time.adaptive.max_step", "larger than the nominal"});
   expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy: 2}}")); },
                {"time.adaptive", "easy"});
-  expect_error([] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 0}}")); },
-               {"time.adaptive.easy_iterations"});
+  expect_error(
+      [] { time_settings(inline_scene("time: {end: 2, steps: 100, adaptive: {max_step: 0.1, easy_iterations: 0}}")); },
+      {"time.adaptive.easy_iterations"});
 }
 
 // A key given twice in one map is refused with both lines (yaml-cpp alone reads the first one).
@@ -134,8 +135,11 @@ TEST(Scene, DuplicateKeysAreRejected) {
 // A typo names the nearest valid key; an unrelated word does not get a suggestion.
 TEST(Scene, UnknownKeySuggestsTheNearest) {
   const Node n = inline_scene("stent: {materail: {E: 1}}");
-  expect_error([&] { n.child("stent").check_keys({"material", "section", "generator"}); },
-               {"inline.yaml", "stent.materail", "unknown key", "did you mean `material`?"});
+  expect_error(
+      [&] {
+        n.child("stent").check_keys({"material", "section", "generator"});
+      },
+      {"inline.yaml", "stent.materail", "unknown key", "did you mean `material`?"});
   try {
     n.child("stent").check_keys({"rings", "crowns"});
     FAIL();

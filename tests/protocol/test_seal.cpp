@@ -79,7 +79,8 @@ TEST(Seal, KeyFileIsReadWhenOwnerOnly) {
   const auto p = key_file("ok.key", kHex + "\n", fs::perms::owner_read | fs::perms::owner_write);
   const auto k = msg::RunKey::read(p);
   std::array<std::uint8_t, msg::RunKey::kKeyBytes> raw{};
-  for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = static_cast<std::uint8_t>(std::stoi(kHex.substr(2 * i, 2), nullptr, 16));
+  for (std::size_t i = 0; i < raw.size(); ++i)
+    raw[i] = static_cast<std::uint8_t>(std::stoi(kHex.substr(2 * i, 2), nullptr, 16));
   const msg::Buffer env = msg::shutdown(msg::Header{"r", 1, fb::Role::Coupler}, "x");
   EXPECT_EQ(k.seal(env), msg::RunKey(raw).seal(env));
 }
@@ -91,11 +92,10 @@ TEST(Seal, BadKeyFilesAreRefusedByName) {
     fs::perms mode;
     std::string expect;
   };
-  for (const Case& c : {Case{"loose.key", kHex, rw | fs::perms::group_read | fs::perms::others_read, "mode 0644"},
-                        Case{"short.key", kHex.substr(2), rw, "64 hex digits"},
-                        Case{"long.key", kHex + "00", rw, "64 hex digits"},
-                        Case{"nothex.key", "zz" + kHex.substr(2), rw, "64 hex digits"},
-                        Case{"empty.key", "", rw, "64 hex digits"}}) {
+  for (const Case& c :
+       {Case{"loose.key", kHex, rw | fs::perms::group_read | fs::perms::others_read, "mode 0644"},
+        Case{"short.key", kHex.substr(2), rw, "64 hex digits"}, Case{"long.key", kHex + "00", rw, "64 hex digits"},
+        Case{"nothex.key", "zz" + kHex.substr(2), rw, "64 hex digits"}, Case{"empty.key", "", rw, "64 hex digits"}}) {
     const auto p = key_file(c.name, c.text, c.mode);
     try {
       msg::RunKey::read(p);

@@ -30,8 +30,12 @@ with tempfile.TemporaryDirectory() as tmp:
     fake.parent.mkdir()
     fake.write_text("#!/bin/sh\necho \"ModuleNotFoundError: No module named 'numpy'\" >&2\nexit 1\n")
     fake.chmod(0o755)
-    env = dict(os.environ, PATH=f"{fake.parent}:{os.environ.get('PATH', '')}", ANGIO_PYTHON=str(fake),
-               BUILD_DIR=str(Path(sys.argv[1]).parent))
+    env = dict(
+        os.environ,
+        PATH=f"{fake.parent}:{os.environ.get('PATH', '')}",
+        ANGIO_PYTHON=str(fake),
+        BUILD_DIR=str(Path(sys.argv[1]).parent),
+    )
 
     def angio(*args):
         r = subprocess.run([str(ANGIO), *map(str, args)], capture_output=True, text=True, env=env, timeout=300)
@@ -39,15 +43,21 @@ with tempfile.TemporaryDirectory() as tmp:
 
     scene = ROOT / "configs" / "generic_artery.yaml"
     code, out = angio("check", scene)
-    check("angio check on the shipped scene: exit 0 with a python3 lacking numpy first",
-          code == 0 and "the scene is valid" in out, out)
+    check(
+        "angio check on the shipped scene: exit 0 with a python3 lacking numpy first",
+        code == 0 and "the scene is valid" in out,
+        out,
+    )
     bad = yaml.safe_load(scene.read_text())
     bad["balloon"]["pressure"]["value"] = 1.0e6
     bad_path = Path(tmp) / "bad.yaml"
     bad_path.write_text(yaml.safe_dump(bad, sort_keys=False))
     code, out = angio("check", bad_path)
-    check("angio check on a bad scene: exit 2 naming file and key",
-          code == 2 and f"{bad_path}: balloon.pressure" in out and "Traceback" not in out, out)
+    check(
+        "angio check on a bad scene: exit 2 naming file and key",
+        code == 2 and f"{bad_path}: balloon.pressure" in out and "Traceback" not in out,
+        out,
+    )
     code, out = angio("frobnicate")
     check("angio with an unknown command: exit 2 and the usage", code == 2 and "angio run SCENE" in out, out)
     code, out = angio("--help")

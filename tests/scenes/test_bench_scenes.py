@@ -33,42 +33,65 @@ def main():
         path = tmp / "bench_short.yaml"
         yaml.safe_dump(scene, open(path, "w"))
         out = tmp / "runs"
-        cmd = ["/usr/bin/python3", str(ROOT / "scripts" / "bench_scenes.py"), str(path), "--out-dir", str(out),
-               "--build-dir", str(bin_dir.parent)]
+        cmd = [
+            "/usr/bin/python3",
+            str(ROOT / "scripts" / "bench_scenes.py"),
+            str(path),
+            "--out-dir",
+            str(out),
+            "--build-dir",
+            str(bin_dir.parent),
+        ]
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
         print(r.stdout[-3000:], r.stderr[-2000:])
         check(r.returncode == 0, f"bench_scenes.py exits 0 (got {r.returncode})")
         doc = json.load(open(out / "bench_scenes.json"))
         check(len(doc["rows"]) == 1, "one row for one scene")
         row = doc["rows"][0]
-        check(row["scene"] == "bench_short" and row["status"] == "ok", f"row of bench_short, status ok ({row['status']})")
+        check(
+            row["scene"] == "bench_short" and row["status"] == "ok", f"row of bench_short, status ok ({row['status']})"
+        )
         check(row["steps"] == 3 and row["cuts"] == 0, f"3 steps, no cuts ({row['steps']}, {row['cuts']})")
         its = row["coupling_iterations_total"]
         check(row["solid_solves"] == its, f"one solid solve per coupling iteration ({row['solid_solves']} vs {its})")
         check(row["solid_dofs"] == 7788 and row["solid_ranks"] == 1, "solid DOFs (1276 hex8 balloon) and ranks")
-        check(0 < row["solid_factorizations"] <= row["solid_newton_iterations"] + row["solid_solves"],
-              "factorizations counted, at most one per Newton iteration or solve")
+        check(
+            0 < row["solid_factorizations"] <= row["solid_newton_iterations"] + row["solid_solves"],
+            "factorizations counted, at most one per Newton iteration or solve",
+        )
         check(0 <= row["solid_contact_s"] <= row["solid_assembly_s"], "contact time is part of the assembly time")
-        check(row["solid_assembly_s"] + row["solid_linear_s"] <= row["solid_s"] * 1.0001,
-              "assembly + linear solve fit in the solid time the coupler measured")
+        check(
+            row["solid_assembly_s"] + row["solid_linear_s"] <= row["solid_s"] * 1.0001,
+            "assembly + linear solve fit in the solid time the coupler measured",
+        )
         check(row["peak_rss_mib"] > 10, f"peak memory measured ({row['peak_rss_mib']:.0f} MiB)")
-        check(row["stent_diameter_max"] is not None and 1.15 <= row["stent_diameter_max"] < 3.0,
-              f"stent diameter from report.py ({row['stent_diameter_max']})")
+        check(
+            row["stent_diameter_max"] is not None and 1.15 <= row["stent_diameter_max"] < 3.0,
+            f"stent diameter from report.py ({row['stent_diameter_max']})",
+        )
         alone = row.get("alone") or {}
         check(alone.get("status") == "ok" and alone.get("steps") == 3, f"the solid-only twin runs 3 steps ({alone})")
         twin = yaml.safe_load(open(out / "bench_short_alone.yaml"))
         check("stent" not in twin and "coupling" not in twin, "the twin has no stent and no coupling section")
-        check(not any(k in twin.get("contact", {}) for k in ("stent_balloon", "stent_artery")),
-              "the twin has no stent contact")
-        r2 = subprocess.run(cmd + ["--compare", str(out / "bench_scenes.json"), "--no-alone",
-                                   "--json", str(tmp / "second.json")], capture_output=True, text=True, timeout=900)
+        check(
+            not any(k in twin.get("contact", {}) for k in ("stent_balloon", "stent_artery")),
+            "the twin has no stent contact",
+        )
+        r2 = subprocess.run(
+            cmd + ["--compare", str(out / "bench_scenes.json"), "--no-alone", "--json", str(tmp / "second.json")],
+            capture_output=True,
+            text=True,
+            timeout=900,
+        )
         print(r2.stdout[-1500:])
         lines = [l for l in r2.stdout.splitlines() if l.startswith("bench_short")]
         check(r2.returncode == 0 and len(lines) == 2, "--compare prints the table row and the comparison row")
         if len(lines) == 2:
             f = lines[1].split()
-            check(float(f[3]) > 0 and f[4] in ("+0.0000", "-0.0000") and f[5] in ("+0.0000", "-0.0000"),
-                  f"comparison: a speedup and unchanged diameters ({lines[1]})")
+            check(
+                float(f[3]) > 0 and f[4] in ("+0.0000", "-0.0000") and f[5] in ("+0.0000", "-0.0000"),
+                f"comparison: a speedup and unchanged diameters ({lines[1]})",
+            )
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0
 

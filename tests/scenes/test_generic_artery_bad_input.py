@@ -29,33 +29,55 @@ CASES = [
     ("viscous tau = 0", lambda s: media(s)["viscous"].update(tau=0.0), "artery.layers.media.viscous.tau"),
     ("viscous beta < 0", lambda s: media(s)["viscous"].update(beta=-0.1), "artery.layers.media.viscous.beta"),
     ("viscous typo", lambda s: media(s)["viscous"].update(taus=0.5), "artery.layers.media.viscous"),
-    ("apposition threshold < 0", lambda s: s["artery"].update(summary={"apposition_threshold": -0.1}),
-     "artery.summary.apposition_threshold"),
-    ("lumen stations huge", lambda s: s["artery"].update(summary={"lumen_stations": 10 ** 9}),
-     "artery.summary.lumen_stations"),
+    (
+        "apposition threshold < 0",
+        lambda s: s["artery"].update(summary={"apposition_threshold": -0.1}),
+        "artery.summary.apposition_threshold",
+    ),
+    (
+        "lumen stations huge",
+        lambda s: s["artery"].update(summary={"lumen_stations": 10**9}),
+        "artery.summary.lumen_stations",
+    ),
     ("layer without material", lambda s: s["artery"]["layers"].pop("adventitia"), "artery.layers"),
     # tolerances that accept a step before it moves (the Newton ladder's atol 1 N ended "ok" uninflated)
     ("solid atol of the order of the load", lambda s: s["solid"]["newton"].update(atol=1.0), "solid.newton.atol"),
     ("coupling rel_tol 1", lambda s: s["coupling"].update(rel_tol=1.0), "coupling.rel_tol"),
     # absurd values inside the type's range: a pressure in Pa or kPa taken for MPa
     ("balloon pressure 1e6 MPa", lambda s: s["balloon"]["pressure"].update(value=1.0e6), "balloon.pressure"),
-    ("blood pressure 85 (mmHg for MPa)", lambda s: s["artery"]["blood_pressure"].update(value=85.0),
-     "artery.blood_pressure"),
+    (
+        "blood pressure 85 (mmHg for MPa)",
+        lambda s: s["artery"]["blood_pressure"].update(value=85.0),
+        "artery.blood_pressure",
+    ),
     # PETSc types and packages that do not exist (would fail at the first solve, after the start)
-    ("unknown preconditioner", lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lux"),
-     "solid.petsc_options"),
-    ("unknown factorization package",
-     lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumpz"),
-     "solid.petsc_options"),
+    (
+        "unknown preconditioner",
+        lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lux"),
+        "solid.petsc_options",
+    ),
+    (
+        "unknown factorization package",
+        lambda s: s["solid"].update(petsc_options="-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumpz"),
+        "solid.petsc_options",
+    ),
     ("continuation 1", lambda s: s["solid"]["newton"].update(continuation=1), "solid.newton.continuation"),
     # the virtual insertion tool and the contact switch-on time
-    ("insertion axis of one point", lambda s: s["contact"].update(insertion={"axis": [[0, 0, 0]], "radius": 0.7}),
-     "contact.insertion.axis"),
-    ("insertion radius negative", lambda s: s["contact"].update(insertion={"axis": [[0, 0, 0], [0, 0, 6]],
-                                                                           "radius": -0.7}),
-     "contact.insertion.radius"),
-    ("contact from not a time", lambda s: s["contact"].update(stent_artery={"penalty": 10.0, "from": "later"}),
-     "contact.stent_artery.from"),
+    (
+        "insertion axis of one point",
+        lambda s: s["contact"].update(insertion={"axis": [[0, 0, 0]], "radius": 0.7}),
+        "contact.insertion.axis",
+    ),
+    (
+        "insertion radius negative",
+        lambda s: s["contact"].update(insertion={"axis": [[0, 0, 0], [0, 0, 6]], "radius": -0.7}),
+        "contact.insertion.radius",
+    ),
+    (
+        "contact from not a time",
+        lambda s: s["contact"].update(stent_artery={"penalty": 10.0, "from": "later"}),
+        "contact.stent_artery.from",
+    ),
 ]
 
 with tempfile.TemporaryDirectory() as tmp:
@@ -64,15 +86,29 @@ with tempfile.TemporaryDirectory() as tmp:
         edit(s)
         scene = Path(tmp) / "bad.yaml"
         scene.write_text(yaml.safe_dump(s, sort_keys=False))
-        r = subprocess.run([sys.executable, str(ROOT / "scripts" / "launch.py"), str(scene), "--run-dir",
-                            str(Path(tmp) / name.replace(" ", "_")), "--build-dir", str(Path(sys.argv[1]).parent)],
-                           capture_output=True, text=True, timeout=120)
+        r = subprocess.run(
+            [
+                sys.executable,
+                str(ROOT / "scripts" / "launch.py"),
+                str(scene),
+                "--run-dir",
+                str(Path(tmp) / name.replace(" ", "_")),
+                "--build-dir",
+                str(Path(sys.argv[1]).parent),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         out = r.stdout + r.stderr
         # the executables check the scene (--check) before the launcher creates the run directory
         left = (Path(tmp) / name.replace(" ", "_")).exists()
         ok = r.returncode == 2 and f"{scene}: {key}" in out and "Traceback" not in out and not left
-        print(("ok   " if ok else "FAIL ") + f"{name}: exit {r.returncode}, names '{key}', "
-              f"run directory {'left behind' if left else 'not created'}", flush=True)
+        print(
+            ("ok   " if ok else "FAIL ") + f"{name}: exit {r.returncode}, names '{key}', "
+            f"run directory {'left behind' if left else 'not created'}",
+            flush=True,
+        )
         if not ok:
             print(out[-1500:])
             failures.append(name)

@@ -53,18 +53,33 @@ def short_scene(end, steps_per_second=50):
 
 
 def run(scene_file, run_dir, ranks, bin_dir):
-    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "launch.py"), str(scene_file), "--run-dir",
-                        str(run_dir), "--build-dir", str(bin_dir.parent), "--ranks", str(ranks)],
-                       capture_output=True, text=True, timeout=1500)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "scripts" / "launch.py"),
+            str(scene_file),
+            "--run-dir",
+            str(run_dir),
+            "--build-dir",
+            str(bin_dir.parent),
+            "--ranks",
+            str(ranks),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=1500,
+    )
     print(r.stdout[-1500:], flush=True)
     check(r.returncode == 0, f"{ranks} rank(s): launch exits 0 (got {r.returncode})\n{r.stderr[-2000:]}")
     return r.returncode == 0
 
 
 def load(run_dir):
-    return {"beam": json.loads((run_dir / "beam" / "summary.json").read_text()),
-            "solid": json.loads((run_dir / "solid" / "summary.json").read_text()),
-            "coupling": json.loads((run_dir / "coupling_summary.json").read_text())}
+    return {
+        "beam": json.loads((run_dir / "beam" / "summary.json").read_text()),
+        "solid": json.loads((run_dir / "solid" / "summary.json").read_text()),
+        "coupling": json.loads((run_dir / "coupling_summary.json").read_text()),
+    }
 
 
 def rel(a, b):
@@ -89,35 +104,59 @@ def main():
             run_dir = Path(tmp) / f"np{ranks}"
             if not run(scene_file, run_dir, ranks, args.bin_dir):
                 continue
-            for f in ["scene.yaml", "coupling.csv", "coupling_summary.json", "beam/summary.json", "beam/beam.h5",
-                      "beam/beam.xdmf", "solid/summary.json", "solid/solid.h5", "solid/solid.xdmf",
-                      "solid/apposition.csv", "results.json", "coupler.log", "beam_solver.log", "solid_solver.log"]:
+            for f in [
+                "scene.yaml",
+                "coupling.csv",
+                "coupling_summary.json",
+                "beam/summary.json",
+                "beam/beam.h5",
+                "beam/beam.xdmf",
+                "solid/summary.json",
+                "solid/solid.h5",
+                "solid/solid.xdmf",
+                "solid/apposition.csv",
+                "results.json",
+                "coupler.log",
+                "beam_solver.log",
+                "solid_solver.log",
+            ]:
                 check((run_dir / f).is_file(), f"{ranks} rank(s): run directory has {f}")
             results[ranks] = load(run_dir)
 
     for ranks, res in results.items():
         c, steps = res["coupling"], res["solid"]["steps"]
         last = steps[-1]
-        check(c["status"] == "ok" and abs(last["time"] - scene["time"]["end"]) < 1e-9,
-              f"{ranks} rank(s): the run reaches t = {scene['time']['end']} s ({c['status']}, {c['steps']} steps "
-              f"for {scene['time']['steps']} planned, cut steps add steps)")
+        check(
+            c["status"] == "ok" and abs(last["time"] - scene["time"]["end"]) < 1e-9,
+            f"{ranks} rank(s): the run reaches t = {scene['time']['end']} s ({c['status']}, {c['steps']} steps "
+            f"for {scene['time']['steps']} planned, cut steps add steps)",
+        )
         force = last["artery_contact_force"]["stent"]
         check(force > 0.0, f"{ranks} rank(s): stent presses on the endothelium at t = {last['time']} ({force:.4g} N)")
         st, ext = res["solid"]["lumen_stations"], last.get("stent_stations")
-        check(ext is not None and min(st) < ext[0] < ext[1] < max(st),
-              f"{ranks} rank(s): the stent's extent {ext} lies within the lumen stations [{min(st)}, {max(st)}]")
+        check(
+            ext is not None and min(st) < ext[0] < ext[1] < max(st),
+            f"{ranks} rank(s): the stent's extent {ext} lies within the lumen stations [{min(st)}, {max(st)}]",
+        )
         app = last["apposition"]
-        check(app["malapposed_fraction"] < 1.0, f"{ranks} rank(s): part of the stent is apposed "
-              f"(malapposed {100 * app['malapposed_fraction']:.1f} %, max gap {app['max_gap']:.3f} mm)")
+        check(
+            app["malapposed_fraction"] < 1.0,
+            f"{ranks} rank(s): part of the stent is apposed "
+            f"(malapposed {100 * app['malapposed_fraction']:.1f} %, max gap {app['max_gap']:.3f} mm)",
+        )
         print(f"     balloon-artery contact force {last['artery_contact_force'].get('balloon', 0):.4g} N")
         for layer in ("media", "adventitia"):
             values = [s["max_principal_stress"][layer] for s in steps[1:]]
-            check(all(v is not None and math.isfinite(v) and v > 0 for v in values),
-                  f"{ranks} rank(s): {layer} max first principal stress finite and positive at every step "
-                  f"(last {values[-1] * 1e3:.3g} kPa, p99 {last['p99_principal_stress'][layer] * 1e3:.3g} kPa)")
+            check(
+                all(v is not None and math.isfinite(v) and v > 0 for v in values),
+                f"{ranks} rank(s): {layer} max first principal stress finite and positive at every step "
+                f"(last {values[-1] * 1e3:.3g} kPa, p99 {last['p99_principal_stress'][layer] * 1e3:.3g} kPa)",
+            )
         for name in ("stent", "balloon"):
-            check(all(math.isfinite(s["artery_contact_force"][name]) for s in steps[1:]),
-                  f"{ranks} rank(s): {name}-artery contact force finite at every step")
+            check(
+                all(math.isfinite(s["artery_contact_force"][name]) for s in steps[1:]),
+                f"{ranks} rank(s): {name}-artery contact force finite at every step",
+            )
 
     if 1 in results and 2 in results:
         a, b = results[1], results[2]
@@ -130,8 +169,10 @@ def main():
                     worst["stress"] = max(worst["stress"], rel(sa[key][layer], sb[key][layer]))
         for k, v in worst.items():
             check(v < RANK_TOL, f"1 vs 2 ranks: largest relative difference of the {k} {v:.2e} < {RANK_TOL}")
-        print(f"     coupling iterations: 1 rank {a['coupling']['coupling_iterations_mean']:.3f} mean, "
-              f"2 ranks {b['coupling']['coupling_iterations_mean']:.3f} mean")
+        print(
+            f"     coupling iterations: 1 rank {a['coupling']['coupling_iterations_mean']:.3f} mean, "
+            f"2 ranks {b['coupling']['coupling_iterations_mean']:.3f} mean"
+        )
     return 1 if failures else 0
 
 

@@ -1,12 +1,12 @@
 #!/usr/bin/python3
 """The default scene of the README run command, run whole: configs/straight_free_expansion.yaml.
 
-Published benchmark (paper §3.1; docs/validation.md, Paper comparison): the stent's mean diameter at 13 atm (≈2.59 mm) and
-after deflation (2.31 mm), and the elastic recoil (0.28 mm); accepted within 2 % for the
+Published benchmark (paper §3.1; docs/validation.md, Paper comparison): the stent's mean diameter at
+13 atm (≈2.59 mm) and after deflation (2.31 mm), and the elastic recoil (0.28 mm); accepted within 2 % for the
 diameters and 10 % for the recoil, the precision to which the paper's figures state them.
-Consistency: the run reaches its end (t = 2.2 s: deflated at 2 s, then held) with every step committed (adaptive steps: at most the 110
-nominal ones, no cut), and the balloon (elastic) returns to its initial outer diameter 0.98 mm at
-zero pressure. The stent's dogboning, (D_distal - D_central)/D_distal, peaks at 20.4 % at
+Consistency: the run reaches its end (t = 2.2 s: deflated at 2 s, then held) with every step committed
+(adaptive steps: at most the 110 nominal ones, no cut), and the balloon (elastic) returns to its initial
+outer diameter 0.98 mm at zero pressure. The stent's dogboning, (D_distal - D_central)/D_distal, peaks at 20.4 % at
 10.4 atm in the paper: accepted within 10 % of its value (a ratio of diameter differences, read at
 load steps 0.26 atm apart), and its peak must lie in the lock-up (8-12 atm), not in the balloon's
 unfolding plateau (5-7 atm), where it sat with end springs 1000x too stiff (7.3 % at 6.2 atm).
@@ -30,14 +30,28 @@ def near(value, reference, rel):
 
 with tempfile.TemporaryDirectory() as tmp:
     run_dir = Path(tmp) / "run"
-    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "launch.py"), str(SCENE), "--run-dir", str(run_dir),
-                        "--build-dir", str(BIN.parent)], capture_output=True, text=True, timeout=2300)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "scripts" / "launch.py"),
+            str(SCENE),
+            "--run-dir",
+            str(run_dir),
+            "--build-dir",
+            str(BIN.parent),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=2300,
+    )
     print(r.stdout[-3000:])
     check(r.returncode == 0, f"launch exits 0 (got {r.returncode})\n{r.stderr[-2000:]}")
     if r.returncode == 0:
         coupling = json.loads((run_dir / "coupling_summary.json").read_text())
-        check(coupling["status"] == "ok" and coupling["steps"] <= 110 and coupling["rejected_attempts"] == 0,
-              f"at most the 110 nominal steps, none cut ({coupling['steps']}, {coupling['rejected_attempts']} cut)")
+        check(
+            coupling["status"] == "ok" and coupling["steps"] <= 110 and coupling["rejected_attempts"] == 0,
+            f"at most the 110 nominal steps, none cut ({coupling['steps']}, {coupling['rejected_attempts']} cut)",
+        )
         d = json.loads((run_dir / "beam" / "summary.json").read_text())["diameter"]
         check(near(d["max"], 2.59, 0.02), f"stent diameter at 13 atm {d['max']:.4f} mm vs paper 2.59 (2 %)")
         check(near(d["final"], 2.31, 0.02), f"stent diameter after deflation {d['final']:.4f} mm vs paper 2.31 (2 %)")

@@ -58,11 +58,16 @@ class SlurmCluster:
         self.env = None
 
     def __enter__(self):
-        missing = [x for x in ("munged", "mungekey", "slurmctld", "slurmd", "sbatch", "squeue", "srun")
-                   if shutil.which(x) is None and not os.path.exists(f"/usr/sbin/{x}")]
+        missing = [
+            x
+            for x in ("munged", "mungekey", "slurmctld", "slurmd", "sbatch", "squeue", "srun")
+            if shutil.which(x) is None and not os.path.exists(f"/usr/sbin/{x}")
+        ]
         if missing:
-            raise ClusterError(f"not installed: {', '.join(missing)} (scripts/setup.sh installs slurmctld, "
-                               "slurmd, slurm-client and munge)")
+            raise ClusterError(
+                f"not installed: {', '.join(missing)} (scripts/setup.sh installs slurmctld, "
+                "slurmd, slurm-client and munge)"
+            )
         if os.geteuid() != 0:
             raise ClusterError("slurmd must run as root to start jobs (this test starts its own cluster)")
         self.dir = tempfile.mkdtemp(prefix="angio-slurm-")
@@ -74,15 +79,34 @@ class SlurmCluster:
         host = socket.gethostname().split(".")[0]
         mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") // 2**20 // 2
         with open(os.path.join(d, "slurm.conf"), "w") as f:
-            f.write(CONF.format(host=host, user="root", ctld_port=free_port(), d_port=free_port(), d=d,
-                                cpus=os.cpu_count() or 1, mem=mem))
+            f.write(
+                CONF.format(
+                    host=host,
+                    user="root",
+                    ctld_port=free_port(),
+                    d_port=free_port(),
+                    d=d,
+                    cpus=os.cpu_count() or 1,
+                    mem=mem,
+                )
+            )
         self.env = dict(os.environ, SLURM_CONF=os.path.join(d, "slurm.conf"))
         sbin = lambda x: shutil.which(x) or f"/usr/sbin/{x}"  # noqa: E731
         m = os.path.join(d, "munge")
         self._run([sbin("mungekey"), "-c", "-k", f"{m}/munge.key"], "mungekey")
-        self._run([sbin("munged"), "-f", f"--socket={m}/munge.sock", f"--key-file={m}/munge.key",
-                   f"--log-file={m}/munged.log", f"--pid-file={m}/munged.pid", f"--seed-file={m}/munged.seed"],
-                  "munged", log=f"{m}/munged.log")
+        self._run(
+            [
+                sbin("munged"),
+                "-f",
+                f"--socket={m}/munge.sock",
+                f"--key-file={m}/munge.key",
+                f"--log-file={m}/munged.log",
+                f"--pid-file={m}/munged.pid",
+                f"--seed-file={m}/munged.seed",
+            ],
+            "munged",
+            log=f"{m}/munged.log",
+        )
         self._run([sbin("slurmctld"), "-i"], "slurmctld", log=f"{d}/slurmctld.log")
         self._run([sbin("slurmd")], "slurmd", log=f"{d}/slurmd.log")
         deadline = time.time() + 60
@@ -92,16 +116,20 @@ class SlurmCluster:
                 return self
             time.sleep(0.5)
         self.__exit__(None, None, None)
-        raise ClusterError(f"the node did not become idle in 60 s (sinfo: {out.stdout.strip()} "
-                           f"{out.stderr.strip()}); slurmctld.log:\n{self._tail(f'{d}/slurmctld.log')}\n"
-                           f"slurmd.log:\n{self._tail(f'{d}/slurmd.log')}")
+        raise ClusterError(
+            f"the node did not become idle in 60 s (sinfo: {out.stdout.strip()} "
+            f"{out.stderr.strip()}); slurmctld.log:\n{self._tail(f'{d}/slurmctld.log')}\n"
+            f"slurmd.log:\n{self._tail(f'{d}/slurmd.log')}"
+        )
 
     def _run(self, cmd, name, log=None):
         out = subprocess.run(cmd, env=self.env, capture_output=True, text=True)
         if out.returncode != 0:
             self.__exit__(None, None, None)
-            raise ClusterError(f"{name} did not start (exit {out.returncode}): {out.stderr.strip()}"
-                               + (f"\n{self._tail(log)}" if log else ""))
+            raise ClusterError(
+                f"{name} did not start (exit {out.returncode}): {out.stderr.strip()}"
+                + (f"\n{self._tail(log)}" if log else "")
+            )
 
     @staticmethod
     def _tail(path, n=15):

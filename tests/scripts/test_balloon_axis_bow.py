@@ -72,7 +72,9 @@ class Script(unittest.TestCase):
             np.savetxt(run / "centerline.txt", line)
             (run / "scene.yaml").write_text("balloon:\n  mesh: {generator: tube, centerline: {file: centerline.txt}}\n")
             (run / "solid").mkdir()
-            (run / "solid" / "summary.json").write_text(json.dumps({"blocks": [{"id": 0, "name": "balloon", "part": "balloon"}]}))
+            (run / "solid" / "summary.json").write_text(
+                json.dumps({"blocks": [{"id": 0, "name": "balloon", "part": "balloon"}]})
+            )
             X = tube_nodes(straight=False)
             # two 8-node cells per ring cover its 12 nodes: every node belongs to the balloon block
             conn = np.array([[q * N_RING + j + o for j in range(8)] for q in range(N_AXIAL) for o in (0, N_RING - 8)])
@@ -80,13 +82,21 @@ class Script(unittest.TestCase):
                 f["mesh/coordinates"] = X
                 f["mesh/hex8/connectivity"] = conn
                 f["mesh/hex8/block_id"] = np.zeros(len(conn), dtype=int)
-                for k, (t, u) in enumerate([(0.0, np.zeros_like(X)), (1.0, tube_nodes(straight=True) - X),
-                                            (2.0, np.tile([3.0, -1.0, 0.5], (len(X), 1)))]):
+                for k, (t, u) in enumerate(
+                    [
+                        (0.0, np.zeros_like(X)),
+                        (1.0, tube_nodes(straight=True) - X),
+                        (2.0, np.tile([3.0, -1.0, 0.5], (len(X), 1))),
+                    ]
+                ):
                     g = f.create_group(f"steps/{k}")
                     g.attrs["time"] = t
                     g["displacement"] = u
-            r = subprocess.run([sys.executable, str(ROOT / "scripts" / "balloon_axis_bow.py"), str(run)],
-                               capture_output=True, text=True)
+            r = subprocess.run(
+                [sys.executable, str(ROOT / "scripts" / "balloon_axis_bow.py"), str(run)],
+                capture_output=True,
+                text=True,
+            )
             self.assertEqual(r.returncode, 0, r.stderr)
             rows = [line.split() for line in r.stdout.splitlines() if line and line[0] == " " and "time" not in line]
             self.assertEqual(len(rows), 3, r.stdout)

@@ -60,8 +60,12 @@ class Case(unittest.TestCase):
 
     def launch(self, scene, *args, run_dir="default", timeout=20):
         rd = [] if run_dir is None else ["--run-dir", str(self.tmp / "run" if run_dir == "default" else run_dir)]
-        return subprocess.run(LAUNCH + [str(scene), "--build-dir", str(self.build), *rd, *args],
-                              capture_output=True, text=True, timeout=timeout)
+        return subprocess.run(
+            LAUNCH + [str(scene), "--build-dir", str(self.build), *rd, *args],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
 
     def assert_refused(self, r, *expected, code=2):
         msg = f"\nexit {r.returncode}\nstdout: {r.stdout}\nstderr: {r.stderr}"
@@ -86,7 +90,11 @@ class SceneFile(Case):
         ("top-level list", "- balloon\n- stent\n", ["expected a YAML map of sections at the top level, got a list"]),
         ("top-level scalar", "balloon\n", ["at the top level, got a str"]),
         ("nested too deeply", "balloon: " + "[" * 5000 + "\n", ["nested too deeply"]),
-        ("nothing to simulate", "time: {end: 1}\nsolid: {ranks: 1}\n", ["expected at least one of 'stent', 'balloon', 'artery'"]),
+        (
+            "nothing to simulate",
+            "time: {end: 1}\nsolid: {ranks: 1}\n",
+            ["expected at least one of 'stent', 'balloon', 'artery'"],
+        ),
     ]
 
     def test_table(self):
@@ -126,12 +134,19 @@ class SceneFile(Case):
 class DuplicateKeys(Case):
     TABLE = [  # name, scene text, key path, line numbers
         ("top-level section", "time: {end: 1}\nballoon: {}\ntime: {end: 2}\n", "time", "lines 1 and 3"),
-        ("in stent.material",
-         "time: {end: 1}\nballoon: {}\nstent:\n  material:\n    E: 380000\n    nu: 0.3\n    E: 200000\n",
-         "stent.material.E", "lines 5 and 7"),
+        (
+            "in stent.material",
+            "time: {end: 1}\nballoon: {}\nstent:\n  material:\n    E: 380000\n    nu: 0.3\n    E: 200000\n",
+            "stent.material.E",
+            "lines 5 and 7",
+        ),
         ("in a flow map", "balloon: {pressure: 1, pressure: 2}\n", "balloon.pressure", "line 1"),
-        ("in a list item", "stent:\n  lines:\n    - {from: 1, to: 2}\n    - from: 3\n      from: 4\n",
-         "stent.lines[1].from", "lines 4 and 5"),
+        (
+            "in a list item",
+            "stent:\n  lines:\n    - {from: 1, to: 2}\n    - from: 3\n      from: 4\n",
+            "stent.lines[1].from",
+            "lines 4 and 5",
+        ),
         ("quoted and plain", "balloon: {}\n'time': {end: 1}\ntime: {end: 2}\n", "time", "lines 2 and 3"),
     ]
 
@@ -139,7 +154,9 @@ class DuplicateKeys(Case):
         for name, text, key, lines in self.TABLE:
             with self.subTest(name):
                 p = self.scene(text)
-                self.assert_refused(self.launch(p), f"{p}: {key}: expected each key once in a map, got it twice ({lines})")
+                self.assert_refused(
+                    self.launch(p), f"{p}: {key}: expected each key once in a map, got it twice ({lines})"
+                )
 
     def test_merge_key_is_not_a_duplicate(self):
         # `<<: *defaults` followed by an override is YAML's merge, not a key given twice
@@ -153,8 +170,11 @@ class Sections(Case):
         for typo, meant in (("stnet", "stent"), ("couplng", "coupling"), ("outptu", "output"), ("ballon", "balloon")):
             with self.subTest(typo):
                 p = self.scene(f"time: {{end: 1}}\nballoon: {{}}\n{typo}: {{}}\n")
-                self.assert_refused(self.launch(p), f"{p}: {typo}: expected a top-level section",
-                                    f"got an unknown key; did you mean `{meant}`?")
+                self.assert_refused(
+                    self.launch(p),
+                    f"{p}: {typo}: expected a top-level section",
+                    f"got an unknown key; did you mean `{meant}`?",
+                )
 
     def test_unknown_without_hint(self):
         p = self.scene("balloon: {}\nzzzz: 1\n")
@@ -178,8 +198,9 @@ class Ranks(Case):
         p = self.scene(SOLID_ONLY)
         for value in ("0", "-2", "257", "1.5", "two", "true"):
             with self.subTest(value):
-                self.assert_refused(self.launch(p, "--ranks", value),
-                                    "argument --ranks: expected an integer in 1..256, got")
+                self.assert_refused(
+                    self.launch(p, "--ranks", value), "argument --ranks: expected an integer in 1..256, got"
+                )
 
 
 class Options(Case):
@@ -208,11 +229,13 @@ class Options(Case):
     def test_internal_error_is_one_line(self):
         # any exception that is no bad input: one line, exit 1 (uuid4 made to fail before the run)
         p = self.scene(SOLID_ONLY)
-        code = ("import runpy, sys, uuid\n"
-                "def boom(): raise RuntimeError('boom\\nsecond line')\n"
-                "uuid.uuid4 = boom\n"
-                f"sys.argv = {[LAUNCH[1], str(p), '--solid-cmd', TRUE, '--run-dir', str(self.tmp / 'run')]!r}\n"
-                f"runpy.run_path({LAUNCH[1]!r}, run_name='__main__')\n")
+        code = (
+            "import runpy, sys, uuid\n"
+            "def boom(): raise RuntimeError('boom\\nsecond line')\n"
+            "uuid.uuid4 = boom\n"
+            f"sys.argv = {[LAUNCH[1], str(p), '--solid-cmd', TRUE, '--run-dir', str(self.tmp / 'run')]!r}\n"
+            f"runpy.run_path({LAUNCH[1]!r}, run_name='__main__')\n"
+        )
         r = subprocess.run([PY, "-c", code], capture_output=True, text=True, timeout=20)
         self.assertEqual(r.returncode, 1, r.stderr)
         self.assertEqual(r.stderr, "launch: internal error: RuntimeError: boom second line\n")
@@ -250,14 +273,21 @@ class Runs(Case):
     def test_run_dir_in_use(self):
         p = self.scene(SOLID_ONLY)
         run = self.tmp / "shared"
-        first = subprocess.Popen(LAUNCH + [str(p), "--run-dir", str(run), "--solid-cmd", fake(3)],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        first = subprocess.Popen(
+            LAUNCH + [str(p), "--run-dir", str(run), "--solid-cmd", fake(3)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         try:
             self.wait_for(lambda: (run / "solid_solver.log").exists(), what="the first launch's solid")
             r = self.launch(p, "--solid-cmd", TRUE, run_dir=run)
             self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
-            self.assertIn(f"launch: error: {run}: expected a free run directory, got one in use by another "
-                          f"launch (pid {first.pid})", r.stderr)
+            self.assertIn(
+                f"launch: error: {run}: expected a free run directory, got one in use by another "
+                f"launch (pid {first.pid})",
+                r.stderr,
+            )
             self.assertNotIn("Traceback", r.stderr)
             out, err = first.communicate(timeout=20)
             self.assertEqual(first.returncode, 0, out + err)
@@ -307,11 +337,14 @@ class Runs(Case):
     def test_no_orphan_after_sigkill(self):
         p = self.scene(SOLID_ONLY)
         marker = f"orphan-marker-{uuid.uuid4().hex}"
-        launcher = subprocess.Popen(LAUNCH + [str(p), "--run-dir", str(self.tmp / "run"),
-                                              "--solid-cmd", fake(60, marker)],
-                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        launcher = subprocess.Popen(
+            LAUNCH + [str(p), "--run-dir", str(self.tmp / "run"), "--solid-cmd", fake(60, marker)],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         child = None
         try:
+
             def find_child():
                 # the marker is one argument of the fake only (the launcher has it inside --solid-cmd)
                 nonlocal child
@@ -328,7 +361,9 @@ class Runs(Case):
             self.assertTrue(alive(child), "the fake solid runs until the launcher is killed")
             launcher.kill()  # SIGKILL: no handler of the launcher runs
             launcher.wait()
-            self.wait_for(lambda: not alive(child), what=f"the fake solid (pid {child}) to end after the launcher's SIGKILL")
+            self.wait_for(
+                lambda: not alive(child), what=f"the fake solid (pid {child}) to end after the launcher's SIGKILL"
+            )
         finally:
             if launcher.poll() is None:
                 launcher.kill()

@@ -17,19 +17,26 @@ sys.path.insert(0, str(ROOT / "scripts"))
 from patient.artery_mesh import TET10_EDGES, WallSpec, build_artery, layer_radii  # noqa: E402
 from patient.centerline_csv import read_centerline_csv, write_centerline_csv  # noqa: E402
 from patient.errors import PatientInputError  # noqa: E402
-from patient.placement import (Device, devices_fit, narrowest_under, nearest_on_polyline, place_device,  # noqa: E402
-                               stenosis_site)
+from patient.placement import (  # noqa: E402
+    Device,
+    devices_fit,
+    narrowest_under,
+    nearest_on_polyline,
+    place_device,  # noqa: E402
+    stenosis_site,
+)
 from patient.prepare import add_insertion  # noqa: E402
 
 
 def arc(n=60, length=12.0, bend=20.0, r0=0.9, stenosis=0.25, noise=0.0, seed=1, wiggle=0.0):
     s = np.linspace(0.0, length, n)
-    pts = np.column_stack([bend * np.sin(s / bend), bend * (1 - np.cos(s / bend)),
-                           0.2 * np.sin(s) + wiggle * np.sin(2 * np.pi * s / 2.5)])
+    pts = np.column_stack(
+        [bend * np.sin(s / bend), bend * (1 - np.cos(s / bend)), 0.2 * np.sin(s) + wiggle * np.sin(2 * np.pi * s / 2.5)]
+    )
     if noise:
         pts = pts + noise * np.random.default_rng(seed).standard_normal(pts.shape)
-    r = r0 * (1 - stenosis * np.exp(-((s - 0.5 * length) / 1.5) ** 2))
-    wall = 0.7 + 0.3 * np.exp(-((s - 0.5 * length) / 1.5) ** 2)
+    r = r0 * (1 - stenosis * np.exp(-(((s - 0.5 * length) / 1.5) ** 2)))
+    wall = 0.7 + 0.3 * np.exp(-(((s - 0.5 * length) / 1.5) ** 2))
     return pts, r, wall
 
 
@@ -151,6 +158,7 @@ class Placement(unittest.TestCase):
 class Insertion(unittest.TestCase):
     """A lesion narrower than the crimped devices: placed all the same with the
     axis kept inside the lumen, and the scene completed with the virtual insertion tool."""
+
     DEV = Device(balloon_length=8.0, balloon_radius=0.49, stent_length=6.0, stent_radius=0.635)
 
     def placement(self):
@@ -174,11 +182,16 @@ class Insertion(unittest.TestCase):
             place_device(cl, self.DEV, stenosis_site(cl))
 
     def scene(self):
-        return {"time": {"start": -0.2, "end": 2.0, "steps": 110},
-                "load_curves": {"balloon": [[-0.2, 0.0], [0.0, 0.0], [1.0, 1.317], [2.0, 0.0]]},
-                "balloon": {"pressure": {"value": 1.0, "curve": "balloon"}},
-                "contact": {"stent_balloon": {"penalty": 10.0}, "stent_artery": {"penalty": 10.0},
-                            "balloon_artery": {"penalty": 50.0}}}
+        return {
+            "time": {"start": -0.2, "end": 2.0, "steps": 110},
+            "load_curves": {"balloon": [[-0.2, 0.0], [0.0, 0.0], [1.0, 1.317], [2.0, 0.0]]},
+            "balloon": {"pressure": {"value": 1.0, "curve": "balloon"}},
+            "contact": {
+                "stent_balloon": {"penalty": 10.0},
+                "stent_artery": {"penalty": 10.0},
+                "balloon_artery": {"penalty": 50.0},
+            },
+        }
 
     def test_tool_opens_before_the_inflation(self):
         _, plc = self.placement()
@@ -187,8 +200,8 @@ class Insertion(unittest.TestCase):
         curve = np.array(done["load_curves"]["insertion_tool"])
         self.assertEqual(done["contact"]["insertion"]["radius"]["curve"], "insertion_tool")
         self.assertEqual(done["contact"]["insertion"]["axis"], "balloon")
-        self.assertLess(curve[0, 1], plc.axis_clearance)             # starts inside the lumen
-        self.assertAlmostEqual(curve[:, 1].max(), 0.635 + 0.065)     # opens to the stent + clearance
+        self.assertLess(curve[0, 1], plc.axis_clearance)  # starts inside the lumen
+        self.assertAlmostEqual(curve[:, 1].max(), 0.635 + 0.065)  # opens to the stent + clearance
         self.assertEqual(np.interp(0.0, curve[:, 0], curve[:, 1]), 0.0)  # gone when the inflation starts
         t_open = curve[np.argmax(curve[:, 1]), 0]
         t_close = curve[curve[:, 1] == curve[:, 1].max(), 0].max()
@@ -212,6 +225,7 @@ class Insertion(unittest.TestCase):
 class ArteryMesh(unittest.TestCase):
     def test_three_layers_tet10(self):
         import gmsh
+
         pts, r, wall = arc(n=30, length=6.0, r0=0.8, stenosis=0.2)
         spec = WallSpec(media_ratio=0.06, adventitia_ratio=0.065, min_intima=0.05)
         with tempfile.TemporaryDirectory(prefix=f"patient-mesh-{os.getpid()}-") as d:
@@ -224,8 +238,18 @@ class ArteryMesh(unittest.TestCase):
                     gmsh.option.setNumber("General.Terminal", 0)
                     gmsh.open(str(out))
                     names = {(dim, gmsh.model.getPhysicalName(dim, tag)) for dim, tag in gmsh.model.getPhysicalGroups()}
-                    self.assertEqual(names, {(3, "intima"), (3, "media"), (3, "adventitia"), (2, "endothelium"),
-                                             (2, "outer"), (2, "end0"), (2, "end1")})
+                    self.assertEqual(
+                        names,
+                        {
+                            (3, "intima"),
+                            (3, "media"),
+                            (3, "adventitia"),
+                            (2, "endothelium"),
+                            (2, "outer"),
+                            (2, "end0"),
+                            (2, "end1"),
+                        },
+                    )
                     types = gmsh.model.mesh.getElementTypes(3)
                     self.assertEqual(list(types), [11])  # tet10 only
                     self.assertEqual(list(gmsh.model.mesh.getElementTypes(2)), [9])  # tri6 faces
@@ -234,7 +258,9 @@ class ArteryMesh(unittest.TestCase):
                     self.assertGreater(det.min(), 0.0)
                     # the endothelium lies on the lumen tube, the outer surface at r + wall
                     for name, target in (("endothelium", 0), ("outer", 3)):
-                        tag = [t for dim, t in gmsh.model.getPhysicalGroups(2) if gmsh.model.getPhysicalName(2, t) == name][0]
+                        tag = [
+                            t for dim, t in gmsh.model.getPhysicalGroups(2) if gmsh.model.getPhysicalName(2, t) == name
+                        ][0]
                         _, xyz = gmsh.model.mesh.getNodesForPhysicalGroup(2, tag)
                         radii, *_ = layer_radii(r, wall, spec, "test")
                         dist, rr = nearest_on_polyline(pts, radii[:, target], xyz.reshape(-1, 3))
@@ -249,6 +275,7 @@ class ArteryMesh(unittest.TestCase):
 
     def test_edge_table_is_gmsh_order(self):
         import gmsh
+
         gmsh.initialize()
         try:
             props = gmsh.model.mesh.getElementProperties(11)  # (name, dim, order, n, local coords, ...)
@@ -263,6 +290,7 @@ class Straightening(unittest.TestCase):
     def test_bow_of_a_circle(self):
         # exact: three points of a circle of radius 5 spanning 60 degrees
         from patient.straightening import bow
+
         R, h = 5.0, math.radians(30)
         p = [np.array([R * math.sin(a), R * (1 - math.cos(a)), 0.0]) for a in (-h, 0.0, h)]
         b = bow(*p)

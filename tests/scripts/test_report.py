@@ -49,18 +49,18 @@ balloon:
 TIMES = [-0.2, -0.1, 0.0, 0.5, 1.0, 1.5, 2.0]
 BALLOON = [0.0, 0.0, 0.0, 0.6585, 1.317, 0.6585, 0.0]
 BLOOD = [0.0, 0.01133, 0.01133, 0.01133, 0.01133, 0.01133, 0.01133]
-MEDIA_MAX = [0.0, 0.0021, 0.0024, 2.5, 8.1, 1.2, 0.19]          # MPa
+MEDIA_MAX = [0.0, 0.0021, 0.0024, 2.5, 8.1, 1.2, 0.19]  # MPa
 MEDIA_P99 = [0.0, 0.0018, 0.0020, 1.1, 3.3, 0.6, 0.09]
 ADV_MAX = [0.0, 0.00015, 0.00016, 0.02, 0.051, 0.03, 0.014]
-ADV_P99 = [0.0, 0.0001, 0.00012, 0.01, 0.03, 0.02, None]         # null as the solid writes it
+ADV_P99 = [0.0, 0.0001, 0.00012, 0.01, 0.03, 0.02, None]  # null as the solid writes it
 # recovered nodal values (*_nodal keys): above the element ones, the media's peak on the lumen surface
 MEDIA_MAX_NODAL = [0.0, 0.0030, 0.0033, 4.0, 12.5, 2.0, 0.31]
 MEDIA_P99_NODAL = [0.0, 0.0025, 0.0028, 1.6, 4.4, 0.8, 0.12]
 MEDIA_ENDO_NODAL = [0.0, 0.0030, 0.0033, 4.0, 12.0, 1.9, 0.30]
 ADV_MAX_NODAL = [0.0, 0.0002, 0.00021, 0.025, 0.06, 0.035, 0.016]
 U_ARTERY = [0.0, 0.12, 0.13, 0.2, 0.3, 0.28, 0.27]
-STENT_D = [1.15, 1.15, 1.16, 1.6, 2.14, 2.16, 1.90]               # beam max (2.16) is not at the peak
-STATIONS = [-5.5 + i for i in range(12)]                           # mm, stent spans -3 .. 3
+STENT_D = [1.15, 1.15, 1.16, 1.6, 2.14, 2.16, 1.90]  # beam max (2.16) is not at the peak
+STATIONS = [-5.5 + i for i in range(12)]  # mm, stent spans -3 .. 3
 STENTED = [s for s in STATIONS if -3.0 <= s <= 3.0]
 
 
@@ -69,7 +69,7 @@ def lumen(phase_d):
 
 
 LUMEN = {0: [1.60] * 12, 2: [1.62] * 12, 4: lumen(2.10), 6: lumen(1.91)}
-LUMEN[6][5] = 1.85                                                  # the narrowest stented station after
+LUMEN[6][5] = 1.85  # the narrowest stented station after
 
 
 def write(path, text):
@@ -81,19 +81,26 @@ def make_artery_run(run):
     write(run / "scene.yaml", ARTERY_SCENE)
     steps = []
     for i, t in enumerate(TIMES):
-        s = {"step": i, "time": t, "balloon_pressure": BALLOON[i], "blood_pressure": BLOOD[i],
-             "max_principal_stress": {"balloon": 1.0 + i, "media": MEDIA_MAX[i], "adventitia": ADV_MAX[i]},
-             "p99_principal_stress": {"balloon": 0.5, "media": MEDIA_P99[i], "adventitia": ADV_P99[i]},
-             "max_principal_stress_at": {"balloon": [0, 0, 3], "media": [0.8, 0, 3], "adventitia": [1.1, 0, 3]},
-             "max_principal_stress_nodal": {"balloon": 2.0 + i, "media": MEDIA_MAX_NODAL[i],
-                                            "adventitia": ADV_MAX_NODAL[i]},
-             "p99_principal_stress_nodal": {"balloon": 0.6, "media": MEDIA_P99_NODAL[i], "adventitia": None},
-             "max_principal_stress_nodal_at": {"balloon": [0, 0, 3], "media": [0.79, 0, 3],
-                                               "adventitia": [1.1, 0, 3]},
-             # only the layer that touches the lumen
-             "max_principal_stress_endothelium_nodal": {"media": MEDIA_ENDO_NODAL[i]},
-             "max_displacement": {"balloon": 0.5 * i, "artery": U_ARTERY[i]},
-             "balloon_outer_diameter": {"mid": 1.0, "end0": 1.1, "end1": 1.1, "dogboning": 0.01 * i}}
+        s = {
+            "step": i,
+            "time": t,
+            "balloon_pressure": BALLOON[i],
+            "blood_pressure": BLOOD[i],
+            "max_principal_stress": {"balloon": 1.0 + i, "media": MEDIA_MAX[i], "adventitia": ADV_MAX[i]},
+            "p99_principal_stress": {"balloon": 0.5, "media": MEDIA_P99[i], "adventitia": ADV_P99[i]},
+            "max_principal_stress_at": {"balloon": [0, 0, 3], "media": [0.8, 0, 3], "adventitia": [1.1, 0, 3]},
+            "max_principal_stress_nodal": {
+                "balloon": 2.0 + i,
+                "media": MEDIA_MAX_NODAL[i],
+                "adventitia": ADV_MAX_NODAL[i],
+            },
+            "p99_principal_stress_nodal": {"balloon": 0.6, "media": MEDIA_P99_NODAL[i], "adventitia": None},
+            "max_principal_stress_nodal_at": {"balloon": [0, 0, 3], "media": [0.79, 0, 3], "adventitia": [1.1, 0, 3]},
+            # only the layer that touches the lumen
+            "max_principal_stress_endothelium_nodal": {"media": MEDIA_ENDO_NODAL[i]},
+            "max_displacement": {"balloon": 0.5 * i, "artery": U_ARTERY[i]},
+            "balloon_outer_diameter": {"mid": 1.0, "end0": 1.1, "end1": 1.1, "dogboning": 0.01 * i},
+        }
         prof = LUMEN.get(i, [1.62 + 0.05 * i] * 12)
         s.update(lumen_diameter=prof, lumen_diameter_min=min(prof), lumen_diameter_max=max(prof))
         if t >= 0:
@@ -101,61 +108,143 @@ def make_artery_run(run):
         if t > 0:
             s["stent_stations"] = [-3.0, 3.0]  # the stent's extent on the lumen stations
         if i == len(TIMES) - 1:
-            s["apposition"] = {"stent_length": 60.0, "malapposed_length": 6.0, "malapposed_fraction": 0.1,
-                               "max_gap": 0.23, "mean_gap": 0.02}
+            s["apposition"] = {
+                "stent_length": 60.0,
+                "malapposed_length": 6.0,
+                "malapposed_fraction": 0.1,
+                "max_gap": 0.23,
+                "mean_gap": 0.02,
+            }
         s.update(newton_iterations=3, residual=1e-9, wall_seconds=0.5)
         steps.append(s)
-    solid = {"units": {"length": "mm", "stress": "MPa", "force": "N", "time": "s"},
-             "blocks": [{"id": 0, "name": "balloon", "part": "balloon"}, {"id": 1, "name": "media", "part": "artery"},
-                        {"id": 2, "name": "adventitia", "part": "artery"}],
-             "lumen_stations": STATIONS, "apposition_threshold": 0.1, "steps": steps}
+    solid = {
+        "units": {"length": "mm", "stress": "MPa", "force": "N", "time": "s"},
+        "blocks": [
+            {"id": 0, "name": "balloon", "part": "balloon"},
+            {"id": 1, "name": "media", "part": "artery"},
+            {"id": 2, "name": "adventitia", "part": "artery"},
+        ],
+        "lumen_stations": STATIONS,
+        "apposition_threshold": 0.1,
+        "steps": steps,
+    }
     write(run / "solid" / "summary.json", json.dumps(solid, indent=1))
-    write(run / "solid" / "apposition.csv",
-          "# stent apposition at t = 2 s: gap = distance (mm); malapposed if gap > 0.1 mm\n"
-          "point,weight,gap,malapposed\n0,10,0.01,0\n1,5,0.23,1\n2,1,inf,1\n")
-    beam_steps = [{"step": i, "time": t, "diameter": STENT_D[i], "iterations": 2, "residual": 1e-10}
-                  for i, t in enumerate(TIMES) if i > 0]
-    beam = {"status": "ok", "diameter": {"initial": 1.15, "max": 2.16, "time_of_max": 1.5, "final": 1.90,
-                                         "recoil": 0.26, "recoil_percent": 12.04},
-            "stent": {"dogboning_max_percent": 3.0, "time_of_dogboning_max": 0.5,
-                      "foreshortening_at_max_diameter_percent": 1.0, "foreshortening_final_percent": 0.8,
-                      "axis_radius_initial": None},
-            "steps": beam_steps}
+    write(
+        run / "solid" / "apposition.csv",
+        "# stent apposition at t = 2 s: gap = distance (mm); malapposed if gap > 0.1 mm\n"
+        "point,weight,gap,malapposed\n0,10,0.01,0\n1,5,0.23,1\n2,1,inf,1\n",
+    )
+    beam_steps = [
+        {"step": i, "time": t, "diameter": STENT_D[i], "iterations": 2, "residual": 1e-10}
+        for i, t in enumerate(TIMES)
+        if i > 0
+    ]
+    beam = {
+        "status": "ok",
+        "diameter": {
+            "initial": 1.15,
+            "max": 2.16,
+            "time_of_max": 1.5,
+            "final": 1.90,
+            "recoil": 0.26,
+            "recoil_percent": 12.04,
+        },
+        "stent": {
+            "dogboning_max_percent": 3.0,
+            "time_of_dogboning_max": 0.5,
+            "foreshortening_at_max_diameter_percent": 1.0,
+            "foreshortening_final_percent": 0.8,
+            "axis_radius_initial": None,
+        },
+        "steps": beam_steps,
+    }
     write(run / "beam" / "summary.json", json.dumps(beam))
-    write(run / "coupling.csv", "step,time,pressure\n" + "".join(
-        f"{i},{t},{BALLOON[i]}\n" for i, t in enumerate(TIMES) if i > 0))
-    write(run / "coupling_summary.json", json.dumps({
-        "status": "ok", "steps": 6, "coupling_iterations_mean": 4.5, "coupling_iterations_max": 9,
-        "wall_time": 100.0, "messaging_share": 0.01}))
+    write(
+        run / "coupling.csv",
+        "step,time,pressure\n" + "".join(f"{i},{t},{BALLOON[i]}\n" for i, t in enumerate(TIMES) if i > 0),
+    )
+    write(
+        run / "coupling_summary.json",
+        json.dumps(
+            {
+                "status": "ok",
+                "steps": 6,
+                "coupling_iterations_mean": 4.5,
+                "coupling_iterations_max": 9,
+                "wall_time": 100.0,
+                "messaging_share": 0.01,
+            }
+        ),
+    )
 
 
 def make_straight_run(run):
     write(run / "scene.yaml", STRAIGHT_SCENE)
     times = [0.5, 1.0, 1.5, 2.0]
     D = [1.8, 2.6, 2.4, 2.3]
-    beam = {"status": "ok", "diameter": {"initial": 1.15, "max": 2.6, "time_of_max": 1.0, "final": 2.3,
-                                         "recoil": 0.3, "recoil_percent": 11.54},
-            "stent": {"dogboning_max_percent": 5.0, "time_of_dogboning_max": 0.5,
-                      "foreshortening_at_max_diameter_percent": 2.0, "foreshortening_final_percent": 1.5,
-                      "axis_radius_initial": None},
-            "steps": [{"step": i + 1, "time": t, "diameter": d} for i, (t, d) in enumerate(zip(times, D))]}
+    beam = {
+        "status": "ok",
+        "diameter": {
+            "initial": 1.15,
+            "max": 2.6,
+            "time_of_max": 1.0,
+            "final": 2.3,
+            "recoil": 0.3,
+            "recoil_percent": 11.54,
+        },
+        "stent": {
+            "dogboning_max_percent": 5.0,
+            "time_of_dogboning_max": 0.5,
+            "foreshortening_at_max_diameter_percent": 2.0,
+            "foreshortening_final_percent": 1.5,
+            "axis_radius_initial": None,
+        },
+        "steps": [{"step": i + 1, "time": t, "diameter": d} for i, (t, d) in enumerate(zip(times, D))],
+    }
     write(run / "beam" / "summary.json", json.dumps(beam))
-    steps = [{"step": i, "time": t, "balloon_pressure": p,
-              "max_principal_stress": {"balloon": 1.0}, "max_displacement": {"balloon": 0.5},
-              "balloon_outer_diameter": {"mid": 1.0, "end0": 1.1, "end1": 1.1, "dogboning": dg}}
-             for i, (t, p, dg) in enumerate(zip([0.0] + times, [0, 0.66, 1.317, 0.66, 0], [0, 0.2, 0.1, 0.05, 0]))]
-    write(run / "solid" / "summary.json", json.dumps({
-        "units": {}, "blocks": [{"id": 0, "name": "balloon", "part": "balloon"}], "steps": steps}))
-    write(run / "coupling.csv", "step,time,pressure\n" + "".join(
-        f"{i + 1},{t},{p}\n" for i, (t, p) in enumerate(zip(times, [0.66, 1.317, 0.66, 0.0]))))
-    write(run / "coupling_summary.json", json.dumps({
-        "status": "ok", "steps": 4, "coupling_iterations_mean": 3.0, "coupling_iterations_max": 5,
-        "wall_time": 10.0, "messaging_share": 0.02}))
+    steps = [
+        {
+            "step": i,
+            "time": t,
+            "balloon_pressure": p,
+            "max_principal_stress": {"balloon": 1.0},
+            "max_displacement": {"balloon": 0.5},
+            "balloon_outer_diameter": {"mid": 1.0, "end0": 1.1, "end1": 1.1, "dogboning": dg},
+        }
+        for i, (t, p, dg) in enumerate(zip([0.0] + times, [0, 0.66, 1.317, 0.66, 0], [0, 0.2, 0.1, 0.05, 0]))
+    ]
+    write(
+        run / "solid" / "summary.json",
+        json.dumps({"units": {}, "blocks": [{"id": 0, "name": "balloon", "part": "balloon"}], "steps": steps}),
+    )
+    write(
+        run / "coupling.csv",
+        "step,time,pressure\n"
+        + "".join(f"{i + 1},{t},{p}\n" for i, (t, p) in enumerate(zip(times, [0.66, 1.317, 0.66, 0.0]))),
+    )
+    write(
+        run / "coupling_summary.json",
+        json.dumps(
+            {
+                "status": "ok",
+                "steps": 4,
+                "coupling_iterations_mean": 3.0,
+                "coupling_iterations_max": 5,
+                "wall_time": 10.0,
+                "messaging_share": 0.02,
+            }
+        ),
+    )
 
 
 def run_report(run):
-    r = subprocess.run([sys.executable, str(REPORT), str(run)], capture_output=True, text=True, timeout=120,
-                       env=dict(os.environ, MPLBACKEND="Agg"))
+    r = subprocess.run(
+        [sys.executable, str(REPORT), str(run)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=dict(os.environ, MPLBACKEND="Agg"),
+    )
     return r
 
 
@@ -165,10 +254,10 @@ def table(stdout):
     head = next(i for i, l in enumerate(lines) if l.startswith("quantity"))
     w = lines[head].index("this run") - 4  # name column width ("quantity".ljust(w) + 2 spaces + 12-wide column)
     rows = {}
-    for l in lines[head + 1:]:
+    for l in lines[head + 1 :]:
         if l.startswith("report:"):
             continue
-        rows[l[:w].rstrip()] = (l[w + 2:w + 14].strip(), l[w + 16:].strip())
+        rows[l[:w].rstrip()] = (l[w + 2 : w + 14].strip(), l[w + 16 :].strip())
     return rows
 
 
@@ -212,11 +301,13 @@ class ArteryReport(unittest.TestCase):
 
     def test_prestressed(self):
         # prestressed = last step with t <= 0: index 2
-        self.assertAlmostEqual(self.ours("prestressed: media max principal stress (kPa)"), MEDIA_MAX[2] * 1000,
-                               places=3)
+        self.assertAlmostEqual(
+            self.ours("prestressed: media max principal stress (kPa)"), MEDIA_MAX[2] * 1000, places=3
+        )
         self.assertAlmostEqual(self.paper("prestressed: media max principal stress (kPa)"), 2.3)
-        self.assertAlmostEqual(self.ours("prestressed: adventitia max principal stress (kPa)"), ADV_MAX[2] * 1000,
-                               places=4)
+        self.assertAlmostEqual(
+            self.ours("prestressed: adventitia max principal stress (kPa)"), ADV_MAX[2] * 1000, places=4
+        )
         self.assertAlmostEqual(self.ours("prestressed: max artery displacement (mm)"), U_ARTERY[2])
         self.assertAlmostEqual(self.paper("prestressed: max artery displacement (mm)"), 0.14)
 
@@ -289,8 +380,13 @@ class ArteryReport(unittest.TestCase):
     def test_plots(self):
         if not has_module("matplotlib"):
             self.skipTest("matplotlib not available to " + sys.executable)
-        for name in ("diameter_vs_time.png", "diameter_vs_pressure.png", "stress_vs_time.png",
-                     "lumen_profile.png", "contact_force_vs_time.png"):
+        for name in (
+            "diameter_vs_time.png",
+            "diameter_vs_pressure.png",
+            "stress_vs_time.png",
+            "lumen_profile.png",
+            "contact_force_vs_time.png",
+        ):
             self.assertTrue((self.run_dir / name).is_file(), name)
 
 
@@ -302,11 +398,23 @@ class StraightReport(unittest.TestCase):
             r = run_report(run)
             self.assertEqual(r.returncode, 0, r.stderr)
             rows = table(r.stdout)
-            expected = ["stent diameter crimped (mm)", "stent diameter max (mm)", "stent diameter final (mm)",
-                        "elastic recoil (mm)", "elastic recoil (%)", "stent dogboning max (%)", "  at time (s)",
-                        "  at pressure (atm)", "foreshortening at max diameter (%)", "foreshortening final (%)",
-                        "balloon dogboning max (%)", "load steps", "coupling iterations mean / max",
-                        "wall time (s)", "messaging share (%)"]
+            expected = [
+                "stent diameter crimped (mm)",
+                "stent diameter max (mm)",
+                "stent diameter final (mm)",
+                "elastic recoil (mm)",
+                "elastic recoil (%)",
+                "stent dogboning max (%)",
+                "  at time (s)",
+                "  at pressure (atm)",
+                "foreshortening at max diameter (%)",
+                "foreshortening final (%)",
+                "balloon dogboning max (%)",
+                "load steps",
+                "coupling iterations mean / max",
+                "wall time (s)",
+                "messaging share (%)",
+            ]
             for name in expected:
                 self.assertIn(name, rows)
             self.assertEqual(rows["stent diameter max (mm)"], ("2.6", "2.59"))
@@ -330,10 +438,18 @@ class EmptyRun(unittest.TestCase):
             make_artery_run(run)
             solid = json.loads((run / "solid" / "summary.json").read_text())
             for s in solid["steps"]:
-                for k in ("lumen_diameter", "lumen_diameter_min", "lumen_diameter_max", "apposition",
-                          "artery_contact_force", "p99_principal_stress", "max_principal_stress_nodal",
-                          "p99_principal_stress_nodal", "max_principal_stress_nodal_at",
-                          "max_principal_stress_endothelium_nodal"):
+                for k in (
+                    "lumen_diameter",
+                    "lumen_diameter_min",
+                    "lumen_diameter_max",
+                    "apposition",
+                    "artery_contact_force",
+                    "p99_principal_stress",
+                    "max_principal_stress_nodal",
+                    "p99_principal_stress_nodal",
+                    "max_principal_stress_nodal_at",
+                    "max_principal_stress_endothelium_nodal",
+                ):
                     s.pop(k, None)
             solid["steps"] = solid["steps"][:4]
             del solid["lumen_stations"]

@@ -33,9 +33,12 @@ PRESSURES = [0.8, 1.0, 1.2]
 
 
 def study_text(**extra):
-    doc = {"base": TINY, "common": {"solid.ranks": 1},
-           "grid": {"balloon.pressure.value": PRESSURES},
-           "plot": {"x": "balloon.pressure.value", "y": ["stent.final"]}}
+    doc = {
+        "base": TINY,
+        "common": {"solid.ranks": 1},
+        "grid": {"balloon.pressure.value": PRESSURES},
+        "plot": {"x": "balloon.pressure.value", "y": ["stent.final"]},
+    }
     doc.update(extra)
     return json.dumps(doc)  # JSON is YAML
 
@@ -64,8 +67,9 @@ class Study(unittest.TestCase):
         return p
 
     def study(self, *args, env=None):
-        return subprocess.run(STUDY + list(args[:1]) + list(args[1:]) + ["--build-dir", BUILD],
-                              capture_output=True, text=True, env=env)
+        return subprocess.run(
+            STUDY + list(args[:1]) + list(args[1:]) + ["--build-dir", BUILD], capture_output=True, text=True, env=env
+        )
 
     def refused(self, text, *words, args=(), env=None):
         p = self.write(text)
@@ -76,8 +80,10 @@ class Study(unittest.TestCase):
         self.assertNotIn("Traceback", r.stderr)
         for w in words:
             self.assertIn(w, r.stderr)
-        self.assertFalse(any(n.startswith("case-") for n in os.listdir(out_dir)) if os.path.isdir(out_dir) else False,
-                         "a refused study ran a case")
+        self.assertFalse(
+            any(n.startswith("case-") for n in os.listdir(out_dir)) if os.path.isdir(out_dir) else False,
+            "a refused study ran a case",
+        )
         return r.stderr
 
     def test_bad_study_files_are_refused_before_anything_runs(self):
@@ -87,8 +93,10 @@ class Study(unittest.TestCase):
         # a misspelt last key is caught by the solver's own key check of the case's scene
         self.refused(study_text(grid={"balloon.pressure.valu": [1.0]}), "case 0", "valu")
         self.refused(study_text(grid={"balloon.pressure.value": [1.0, 1.0]}), "cases 0 and 1 are the same case")
-        self.refused(study_text(grid=None, cases=[{"balloon.pressure.value": 1.0}, {"balloon.pressure.value": 1.0}]),
-                     "the same case")
+        self.refused(
+            study_text(grid=None, cases=[{"balloon.pressure.value": 1.0}, {"balloon.pressure.value": 1.0}]),
+            "the same case",
+        )
         self.refused(study_text(patients=["nope.csv"]), "patients[0]: nope.csv: no such file")
         self.refused(study_text(base="missing.yaml"), "base:")
         # a Slurm runner without sbatch: nothing submitted
@@ -153,8 +161,11 @@ class Study(unittest.TestCase):
                     break
                 time.sleep(2)
             if st.returncode != 0:
-                logs = [read(os.path.join(array, "slurm", f)) for f in os.listdir(os.path.join(array, "slurm"))
-                        if f.endswith(".out")]
+                logs = [
+                    read(os.path.join(array, "slurm", f))
+                    for f in os.listdir(os.path.join(array, "slurm"))
+                    if f.endswith(".out")
+                ]
                 self.fail("the array did not finish in 300 s:\n" + st.stdout + "\n".join(logs))
         r = subprocess.run(STUDY + ["table", p, "--out-dir", array], capture_output=True, text=True)
         self.assertEqual(r.returncode, 0, r.stderr)

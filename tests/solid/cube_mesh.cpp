@@ -21,17 +21,18 @@ Mesh cube_mesh(ElemType t, int n, double perturb, unsigned seed) {
       for (int i = 0; i <= n; ++i) {
         Vec3d x(double(i) / n, double(j) / n, double(k) / n);
         const bool b = i == 0 || j == 0 || k == 0 || i == n || j == n || k == n;
-        if (!b) x += Vec3d(U(rng), U(rng), U(rng)) / n;
-        else boundary.push_back(id(i, j, k));
+        if (!b)
+          x += Vec3d(U(rng), U(rng), U(rng)) / n;
+        else
+          boundary.push_back(id(i, j, k));
         m.X.push_back(x);
       }
   std::map<std::pair<int, int>, int> mid;
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
-        const int v[8] = {id(i, j, k),         id(i + 1, j, k),         id(i + 1, j + 1, k),
-                          id(i, j + 1, k),     id(i, j, k + 1),         id(i + 1, j, k + 1),
-                          id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
+        const int v[8] = {id(i, j, k),     id(i + 1, j, k),     id(i + 1, j + 1, k),     id(i, j + 1, k),
+                          id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
         if (t == ElemType::Hex8) {
           Element e;
           e.type = ElemType::Hex8;
@@ -46,8 +47,7 @@ Mesh cube_mesh(ElemType t, int n, double perturb, unsigned seed) {
           Element e;
           e.type = t;
           for (int a = 0; a < 4; ++a) e.n[a] = v[tt[a]];
-          const Vec3d d1 = m.X[e.n[1]] - m.X[e.n[0]], d2 = m.X[e.n[2]] - m.X[e.n[0]],
-                      d3 = m.X[e.n[3]] - m.X[e.n[0]];
+          const Vec3d d1 = m.X[e.n[1]] - m.X[e.n[0]], d2 = m.X[e.n[2]] - m.X[e.n[0]], d3 = m.X[e.n[3]] - m.X[e.n[0]];
           if (d1.cross(d2).dot(d3) < 0) std::swap(e.n[1], e.n[2]);
           if (t == ElemType::Tet10) {
             static const int ed[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};

@@ -114,6 +114,7 @@ TEST(ArteryMeasures, NodalAreasSumToTheSurfaceArea) {
   double sum = 0.0;
   for (double a : area) sum += a;
   // the end face is a ring of 12 plane trapezoids between r = 0.8 and 1.1: area 12 sin(π/12)cos(π/12)(1.1² − 0.8²)
-  const double exact = 12.0 * std::sin(std::numbers::pi / 12) * std::cos(std::numbers::pi / 12) * (1.1 * 1.1 - 0.8 * 0.8);
+  const double exact =
+      12.0 * std::sin(std::numbers::pi / 12) * std::cos(std::numbers::pi / 12) * (1.1 * 1.1 - 0.8 * 0.8);
   EXPECT_NEAR(sum, exact, 1e-12);
 }

@@ -43,16 +43,17 @@ TEST(Balloon, FreeInflationPlateauAndLockup) {
   const double d0 = h.front().d_mid, d03 = d_at(0.3, true), d05 = d_at(0.5, true), d07 = d_at(0.7, true),
                d10 = d_at(1.0, true), dmax = d_at(1.317, true), dend = h.back().d_mid;
   if (angio_test::world_rank() == 0)
-    std::printf("balloon D_mid: p=0 %.3f, 0.3 %.3f, 0.5 %.3f, 0.7 %.3f, 1.0 %.3f, 1.317 %.3f, deflated %.4f mm "
-                "(%zu steps, %.1f s)\n",
-                d0, d03, d05, d07, d10, dmax, dend, h.size() - 1, MPI_Wtime() - t0);
+    std::printf(
+        "balloon D_mid: p=0 %.3f, 0.3 %.3f, 0.5 %.3f, 0.7 %.3f, 1.0 %.3f, 1.317 %.3f, deflated %.4f mm "
+        "(%zu steps, %.1f s)\n",
+        d0, d03, d05, d07, d10, dmax, dend, h.size() - 1, MPI_Wtime() - t0);
   EXPECT_NEAR(d0, 0.98, 1e-9);
   const double slope_start = (d03 - d0) / 0.3, slope_plateau = (d07 - d05) / 0.2,
                slope_lockup = (dmax - d10) / 0.317;  // mm/MPa
-  EXPECT_LT(d03, 1.6);                           // stiff start below the unfolding pressure
-  EXPECT_GT(slope_plateau, 3.0 * slope_start);   // unfolding plateau: steep growth at 0.5-0.7 MPa
-  EXPECT_LT(slope_lockup, 0.1 * slope_plateau);  // lock-up near the nominal diameter
-  EXPECT_GT(dmax, 2.3);                          // paper: stent ~2.59 mm at 13 atm, BioMatrix 2.71 mm
+  EXPECT_LT(d03, 1.6);                               // stiff start below the unfolding pressure
+  EXPECT_GT(slope_plateau, 3.0 * slope_start);       // unfolding plateau: steep growth at 0.5-0.7 MPa
+  EXPECT_LT(slope_lockup, 0.1 * slope_plateau);      // lock-up near the nominal diameter
+  EXPECT_GT(dmax, 2.3);                              // paper: stent ~2.59 mm at 13 atm, BioMatrix 2.71 mm
   EXPECT_LT(dmax, 2.9);
-  EXPECT_NEAR(dend, 0.98, 0.01);         // elastic: back to the initial diameter
+  EXPECT_NEAR(dend, 0.98, 0.01);  // elastic: back to the initial diameter
 }

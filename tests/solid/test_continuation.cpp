@@ -49,7 +49,7 @@ TEST(Continuation, LargeStepReachesTheSmallStepEquilibrium) {
   for (double t : {0.5, 1.0}) {
     const double dc = d_at(cont.history(), t), df = d_at(fine.history(), t);
     if (angio_test::world_rank() == 0) std::printf("t = %.1f: D_mid continued %.6f, small steps %.6f mm\n", t, dc, df);
-    EXPECT_GT(dc, 1.2);               // inflated, not stuck at the start
-    EXPECT_NEAR(dc, df, 1e-5);        // the same equilibrium (Newton atol 1e-8 N)
+    EXPECT_GT(dc, 1.2);         // inflated, not stuck at the start
+    EXPECT_NEAR(dc, df, 1e-5);  // the same equilibrium (Newton atol 1e-8 N)
   }
 }

@@ -123,12 +123,10 @@ TEST(CurvedTube, SurfacesAndEnds) {
       check(face_area_vector(f.type, X), fc);
     }
   };
-  face_check("balloon_inner", [&](const Vec3d& A, const Vec3d& fc) {
-    EXPECT_LT(A.dot(fc - t.centerline->closest(fc).foot), 0.0);
-  });
-  face_check("balloon_outer", [&](const Vec3d& A, const Vec3d& fc) {
-    EXPECT_GT(A.dot(fc - t.centerline->closest(fc).foot), 0.0);
-  });
+  face_check("balloon_inner",
+             [&](const Vec3d& A, const Vec3d& fc) { EXPECT_LT(A.dot(fc - t.centerline->closest(fc).foot), 0.0); });
+  face_check("balloon_outer",
+             [&](const Vec3d& A, const Vec3d& fc) { EXPECT_GT(A.dot(fc - t.centerline->closest(fc).foot), 0.0); });
   face_check("balloon_end0", [&](const Vec3d& A, const Vec3d& fc) {
     EXPECT_NEAR(t.centerline->closest(fc).s, 2.0, 1e-10);
     EXPECT_LT(A.dot(t.centerline->frame(2.0).tangent), 0.0);  // out of the tube: backwards
@@ -148,7 +146,8 @@ TEST(CurvedTube, StraightCenterlineReproducesStraightTube) {
   a.length = 9.4;
   a.center = Vec3d(0.2, -0.1, 3.0);
   TubeSpec b = a;
-  b.centerline = Centerline({Vec3d(0.2, -0.1, 3.0 - 4.7 - 1.0), Vec3d(0.2, -0.1, 3.0), Vec3d(0.2, -0.1, 3.0 + 4.7 + 2.0)});
+  b.centerline =
+      Centerline({Vec3d(0.2, -0.1, 3.0 - 4.7 - 1.0), Vec3d(0.2, -0.1, 3.0), Vec3d(0.2, -0.1, 3.0 + 4.7 + 2.0)});
   b.start = 1.0;
   const Mesh ma = make_tube(a), mb = make_tube(b);
   ASSERT_EQ(ma.X.size(), mb.X.size());

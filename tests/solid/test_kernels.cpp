@@ -191,8 +191,9 @@ TEST(Elements, InternalForceTangentMatchesFiniteDifferences) {
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
     ASSERT_TRUE(element_internal(t, X, u, adv.matrix, fibers, f, &K));
-    const Eigen::MatrixXd Kfd = angio_test::fd_tangent(
-        u, [&](const Eigen::MatrixXd& v, Eigen::VectorXd& fv) { element_internal(t, X, v, adv.matrix, fibers, fv, nullptr); });
+    const Eigen::MatrixXd Kfd = angio_test::fd_tangent(u, [&](const Eigen::MatrixXd& v, Eigen::VectorXd& fv) {
+      element_internal(t, X, v, adv.matrix, fibers, fv, nullptr);
+    });
     EXPECT_LT((K - Kfd).norm(), 1e-6 * K.norm()) << name(t);
     EXPECT_LT((K - K.transpose()).norm(), 1e-10 * K.norm()) << name(t);
   }
@@ -206,10 +207,10 @@ TEST(Elements, FollowerPressureTangentMatchesFiniteDifferences) {
   for (FaceType t : {FaceType::Quad4, FaceType::Tri3, FaceType::Tri6}) {
     const int n = num_nodes(t);
     Eigen::MatrixXd x(n, 3);
-    const std::vector<Vec3d> ref = t == FaceType::Quad4
-                                       ? std::vector<Vec3d>{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}
-                                       : std::vector<Vec3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0},
-                                                            {0.5, 0, 0}, {0.5, 0.5, 0}, {0, 0.5, 0}};
+    const std::vector<Vec3d> ref =
+        t == FaceType::Quad4
+            ? std::vector<Vec3d>{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}
+            : std::vector<Vec3d>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.5, 0, 0}, {0.5, 0.5, 0}, {0, 0.5, 0}};
     for (int a = 0; a < n; ++a) x.row(a) = ref[a].transpose();
     Eigen::VectorXd r;
     face_pressure(t, x, 2.0, r, nullptr);

@@ -192,7 +192,7 @@ TEST(Model, DampingConvergesToTheEquilibrium) {
   EXPECT_GT(f[0], 0.0);
   std::vector<double> g;
   EXPECT_LT(max_diff(solve_cube(1.0, 2.0, 1, g, it), u1), 1e-12 * scale);  // η/Δt is what counts
-  EXPECT_GT(max_diff(solve_cube(0.5, 0.5, 1, g, it), u_ref), 1.2 * err1);   // a shorter step damps harder
+  EXPECT_GT(max_diff(solve_cube(0.5, 0.5, 1, g, it), u_ref), 1.2 * err1);  // a shorter step damps harder
   f.clear();
   const auto u = solve_cube(0.5, 1.0, 20, f, it);
   EXPECT_LT(max_diff(u, u_ref), 1e-8 * scale);
@@ -307,7 +307,7 @@ TEST(Model, ModifiedNewtonGivesTheSameSolutionWithFewerFactorizations) {
   EXPECT_LT(max_diff(u0, u1), 1e-9 * scale);
   EXPECT_LT(max_diff(u0, u2), 1e-9 * scale);
   EXPECT_EQ(exact.factorizations, exact.newton_iterations);
-  EXPECT_LT(mod.factorizations, 8);  // fewer than one per step
+  EXPECT_LT(mod.factorizations, 8);                           // fewer than one per step
   EXPECT_GT(mod.newton_iterations, exact.newton_iterations);  // linear instead of quadratic convergence
   EXPECT_LT(mod.tangent_assemblies, mod.newton_iterations);   // most iterations: residual only
   EXPECT_GE(strict.factorizations, strict.newton_iterations - 7);
@@ -325,9 +325,9 @@ TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
   const double p = 0.05, beta = 0.3;
   const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 2, 0.08, 9);
   auto elastic = [&](double scale_matrix, double scale_fibers) {
-    auto model = pressed_cube(
-        m, LayerMaterial{"cube", {2.0 * scale_matrix, 0.3}, {{0.4 * scale_fibers, 1.5, 20.0, true}}},
-        direct_options(), p);
+    auto model =
+        pressed_cube(m, LayerMaterial{"cube", {2.0 * scale_matrix, 0.3}, {{0.4 * scale_fibers, 1.5, 20.0, true}}},
+                     direct_options(), p);
     EXPECT_TRUE(model->solve().converged);
     return displacements(*model);
   };
@@ -489,7 +489,8 @@ static void check_fiber_output(const SolidModel& model, const std::string& dir) 
   const size_t steps = count("<Grid Name=\"step_");
   EXPECT_GE(steps, 2u);
   for (const char* name : {"frame_circumferential", "frame_axial", "frame_radial", "fiber_1", "fiber_2"})
-    EXPECT_EQ(count(std::string("Attribute Name=\"") + name + "\" AttributeType=\"Vector\" Center=\"Cell\""), steps) << name;
+    EXPECT_EQ(count(std::string("Attribute Name=\"") + name + "\" AttributeType=\"Vector\" Center=\"Cell\""), steps)
+        << name;
   EXPECT_NE(xdmf.find("solid.h5:/mesh/hex8/fiber_2<"), std::string::npos);
 }
 
@@ -592,8 +593,8 @@ TEST(Scene, ViscousActsOnIsCheckedAndDefaultsToIsotropic) {
   auto scene_with = [&](const std::string& viscous) {
     std::string t = text;
     t.replace(t.find(key), key.size(), key + "viscous: " + viscous + ", ");
-    const std::string path = std::filesystem::temp_directory_path() /
-                             ("angio_acts_on_" + std::to_string(getpid()) + "_" + std::to_string(world_rank()) + ".yaml");
+    const std::string path = std::filesystem::temp_directory_path() / ("angio_acts_on_" + std::to_string(getpid()) +
+                                                                       "_" + std::to_string(world_rank()) + ".yaml");
     std::ofstream(path) << t;
     return path;
   };

@@ -183,7 +183,8 @@ TEST(Recovery, PatchTestConstantStressAtEveryNode) {
         ++nodes;
       }
       EXPECT_EQ(nodes, model.owned_node_end() - model.owned_node_begin());
-      EXPECT_LT(global_max(err), 1e-10 * s.norm()) << name(t) << (mass == StressRecovery::Mass::lumped ? " lumped" : "");
+      EXPECT_LT(global_max(err), 1e-10 * s.norm())
+          << name(t) << (mass == StressRecovery::Mass::lumped ? " lumped" : "");
     }
   }
 }
@@ -228,9 +229,10 @@ TEST(Recovery, ThickCylinderInnerSurfaceIsCloserToLame) {
     const double lumped = inner_error(StressRecovery::Mass::lumped);
     elem_err = global_max(elem_err);
     if (world_rank() == 0)
-      std::printf("    %d across: Lame sigma_theta(a) = %.6g, relative error element average %.4f, recovered "
-                  "consistent %.4f, lumped %.4f\n",
-                  n_radial, exact, elem_err / exact, consistent / exact, lumped / exact);
+      std::printf(
+          "    %d across: Lame sigma_theta(a) = %.6g, relative error element average %.4f, recovered "
+          "consistent %.4f, lumped %.4f\n",
+          n_radial, exact, elem_err / exact, consistent / exact, lumped / exact);
     EXPECT_LT(consistent, elem_err / 3.0) << n_radial;
     EXPECT_LT(consistent, lumped) << n_radial;
     EXPECT_LT(consistent, 0.06 * exact) << n_radial;
@@ -321,7 +323,8 @@ TEST(Recovery, InterfaceNodesCarryOneValuePerLayer) {
   for (size_t i = 0; i < p1.size(); ++i) {
     const int e = model.local_elements()[i];
     const Vec3d c = element_centroid(m, e);
-    if (std::abs(std::hypot(c.x(), c.y()) - r_if) < 0.6 * h) elem[m.elements[e].block] = std::max(elem[m.elements[e].block], p1[i]);
+    if (std::abs(std::hypot(c.x(), c.y()) - r_if) < 0.6 * h)
+      elem[m.elements[e].block] = std::max(elem[m.elements[e].block], p1[i]);
   }
   elem[0] = global_max(elem[0]);
   elem[1] = global_max(elem[1]);
@@ -367,7 +370,8 @@ TEST(Recovery, RunnerWritesNodalFieldsAndSummary) {
   MPI_Barrier(PETSC_COMM_WORLD);
   if (world_rank() != 0) return;
   const Mesh& mesh = runner.model().mesh();
-  EXPECT_EQ(nodal_stress_field_names(mesh), (std::vector<std::string>{"stress_p1_nodal_media", "stress_p1_nodal_adventitia"}));
+  EXPECT_EQ(nodal_stress_field_names(mesh),
+            (std::vector<std::string>{"stress_p1_nodal_media", "stress_p1_nodal_adventitia"}));
   // solid.h5: rows in the file's node order (new numbering), NaN exactly at nodes outside the layer
   const std::string h5 = dir + "/solid/solid.h5";
   auto read = [&](const std::string& path, hid_t type, std::vector<char>& buf, size_t elem) {
@@ -468,8 +472,9 @@ TEST(Recovery, DISABLED_CostOnTheGenericArteryMesh) {
     const double stress = MPI_Wtime() - te;
     ASSERT_TRUE(rec.recover(gauss));
     if (world_rank() == 0)
-      std::printf("    %zu elements, %zu nodes, %d rank(s): setup %.3f s, element_stress %.3f s, recover %.3f s "
-                  "(%d CG iterations over 6 components)\n",
-                  m.elements.size(), m.X.size(), world_size(), setup, stress, rec.last_seconds(), rec.last_iterations());
+      std::printf(
+          "    %zu elements, %zu nodes, %d rank(s): setup %.3f s, element_stress %.3f s, recover %.3f s "
+          "(%d CG iterations over 6 components)\n",
+          m.elements.size(), m.X.size(), world_size(), setup, stress, rec.last_seconds(), rec.last_iterations());
   }
 }

@@ -71,7 +71,8 @@ TEST(RecoveryKernel, TetRulesIntegrateMonomialsExactly) {
       for (int j = 0; i + j <= degree; ++j)
         for (int k = 0; i + j + k <= degree; ++k) {
           double sum = 0.0;
-          for (const auto& qp : rule) sum += qp.w * std::pow(qp.xi[0], i) * std::pow(qp.xi[1], j) * std::pow(qp.xi[2], k);
+          for (const auto& qp : rule)
+            sum += qp.w * std::pow(qp.xi[0], i) * std::pow(qp.xi[1], j) * std::pow(qp.xi[2], k);
           const double exact = factorial(i) * factorial(j) * factorial(k) / factorial(i + j + k + 3);
           EXPECT_NEAR(sum, exact, 1e-15) << name(t) << " x^" << i << " y^" << j << " z^" << k;
         }

@@ -61,7 +61,8 @@ const char* kBalloon = R"(balloon:
 
 std::string dir_of(const std::string& name) {
   // per rank count: the np1 and np2 test runs may run concurrently
-  return (std::filesystem::current_path() / ("state_file_test_np" + std::to_string(world_size()) + "/" + name)).string();
+  return (std::filesystem::current_path() / ("state_file_test_np" + std::to_string(world_size()) + "/" + name))
+      .string();
 }
 
 // Writes the scene (rank 0) and returns its path; `time` replaces the time line, `initial` the
@@ -130,13 +131,12 @@ TEST(StateFile, ContinuedRunEndsWhereTheUninterruptedRunEnds) {
   for (const auto& Q : state.parts[0].Q) q = std::max(q, Q.norm());
   EXPECT_GT(q, 1e-4);  // the media's overstress at the end of the ramp (MPa): the history is not trivial
 
-  const auto continued = run(scene_file("second_half", "time: {start: 0.5, end: 1.0, steps: 4}", initial()),
-                             dir_of("second_half"));
+  const auto continued =
+      run(scene_file("second_half", "time: {start: 0.5, end: 1.0, steps: 4}", initial()), dir_of("second_half"));
   double umax = 0.0;
   for (const auto& u : whole) umax = std::max(umax, u.norm());
   const double diff = max_difference(whole, continued);
-  if (world_rank() == 0)
-    std::printf("max |u| at t = 1: %.6f mm, continued - uninterrupted: %.3e mm\n", umax, diff);
+  if (world_rank() == 0) std::printf("max |u| at t = 1: %.6f mm, continued - uninterrupted: %.3e mm\n", umax, diff);
   EXPECT_GT(umax, 0.05);
   EXPECT_LT(diff, 1e-10 * umax);
 
@@ -162,7 +162,8 @@ TEST(StateFile, PartsLandOnTheirNodesOthersStartUndeformed) {
   const auto nodes = part_nodes(mesh, "artery");
   ASSERT_EQ(nodes.size(), state.parts[0].u.size());
   double diff = 0.0, balloon = 0.0;
-  for (size_t i = 0; i < nodes.size(); ++i) diff = std::max(diff, (runner.model().displacement(nodes[i]) - state.parts[0].u[i]).norm());
+  for (size_t i = 0; i < nodes.size(); ++i)
+    diff = std::max(diff, (runner.model().displacement(nodes[i]) - state.parts[0].u[i]).norm());
   for (int n : part_nodes(mesh, "balloon")) balloon = std::max(balloon, runner.model().displacement(n).norm());
   EXPECT_EQ(diff, 0.0);
   EXPECT_EQ(balloon, 0.0);
@@ -179,10 +180,12 @@ TEST(StateFile, MismatchesAreSceneErrorsNamingTheKey) {
     return std::string("accepted");
   };
   const std::string t = "time: {start: 0.5, end: 1.0, steps: 1}";
-  EXPECT_NE(message(scene_file("other_mesh", t, initial(), false, 16)).find("solid.initial_state.file: expected parts that fit this scene's mesh"),
+  EXPECT_NE(message(scene_file("other_mesh", t, initial(), false, 16))
+                .find("solid.initial_state.file: expected parts that fit this scene's mesh"),
             std::string::npos);
   EXPECT_NE(message(scene_file("other_mesh", t, initial(), false, 16)).find("a different mesh"), std::string::npos);
-  EXPECT_NE(message(scene_file("no_part", t, initial("[balloon]"), true)).find("has no part 'balloon'"), std::string::npos);
+  EXPECT_NE(message(scene_file("no_part", t, initial("[balloon]"), true)).find("has no part 'balloon'"),
+            std::string::npos);
   EXPECT_NE(message(scene_file("twice", t, initial("[artery, artery]"))).find("each part once"), std::string::npos);
   EXPECT_NE(message(scene_file("time", "time: {start: 0.25, end: 1.0, steps: 1}", initial())).find("time.start"),
             std::string::npos);

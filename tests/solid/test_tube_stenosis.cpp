@@ -29,7 +29,8 @@ double hex_volume(const Mesh& m, const Element& e) {
   static const int tets[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
   double v = 0.0;
   for (const auto& t : tets) {
-    const Vec3d a = m.X[e.n[t[1]]] - m.X[e.n[t[0]]], b = m.X[e.n[t[2]]] - m.X[e.n[t[0]]], c = m.X[e.n[t[3]]] - m.X[e.n[t[0]]];
+    const Vec3d a = m.X[e.n[t[1]]] - m.X[e.n[t[0]]], b = m.X[e.n[t[2]]] - m.X[e.n[t[0]]],
+                c = m.X[e.n[t[3]]] - m.X[e.n[t[0]]];
     v += a.dot(b.cross(c)) / 6.0;
   }
   return v;
@@ -45,7 +46,8 @@ TEST(TubeStenosis, LumenFollowsTheCosineBumpAndOuterLayersKeepTheirRadii) {
     const double r = std::hypot(x.x(), x.y()), z = x.z();
     EXPECT_NEAR(r, t.stenosis.lumen_radius(1.5, z), 1e-12);
     const double d = z - 1.0;
-    const double expected = std::abs(d) <= 3.0 ? 1.5 * (1.0 - 0.35 * (1.0 + std::cos(std::numbers::pi * d / 3.0))) : 1.5;
+    const double expected =
+        std::abs(d) <= 3.0 ? 1.5 * (1.0 - 0.35 * (1.0 + std::cos(std::numbers::pi * d / 3.0))) : 1.5;
     EXPECT_NEAR(r, expected, 1e-12) << "z = " << z;
     r_min = std::min(r_min, r);
   }

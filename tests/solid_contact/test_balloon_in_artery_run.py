@@ -12,10 +12,16 @@ import sys
 import tempfile
 
 bin_dir, scene = sys.argv[1], sys.argv[2]
-mpirun = ["mpirun", "-n", "2", "--oversubscribe", "--bind-to", "none"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
+mpirun = ["mpirun", "-n", "2", "--oversubscribe", "--bind-to", "none"] + (
+    ["--allow-run-as-root"] if os.geteuid() == 0 else []
+)
 with tempfile.TemporaryDirectory() as tmp:
-    r = subprocess.run(mpirun + [os.path.join(bin_dir, "solid_solver"), "--scene", scene, "--run-dir", tmp],
-                       capture_output=True, text=True, timeout=280)
+    r = subprocess.run(
+        mpirun + [os.path.join(bin_dir, "solid_solver"), "--scene", scene, "--run-dir", tmp],
+        capture_output=True,
+        text=True,
+        timeout=280,
+    )
     print(r.stdout[-3000:])
     print(r.stderr[-3000:], file=sys.stderr)
     if r.returncode != 0:

@@ -267,7 +267,8 @@ void check_model_tangent(bool averaged_normals) {
   }
   double g[3] = {max_err, max_k, max_cross}, gg[3];
   MPI_Allreduce(g, gg, 3, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
-  if (world_rank() == 0) std::printf("  tangent: max |K - K_fd| = %.3e, max |K| = %.3e, max |K_cross| = %.3e\n", gg[0], gg[1], gg[2]);
+  if (world_rank() == 0)
+    std::printf("  tangent: max |K - K_fd| = %.3e, max |K| = %.3e, max |K_cross| = %.3e\n", gg[0], gg[1], gg[2]);
   EXPECT_LT(gg[0], 1e-6 * gg[1]);
   EXPECT_GT(gg[2], 1e-3 * gg[1]);
   VecDestroy(&r);
@@ -302,9 +303,10 @@ TEST(StentContact, CostOfManyPoints) {
   const double t_asm = (MPI_Wtime() - t0) / reps;
   const double t_contact = contact.timing().seconds / double(contact.timing().calls);
   if (world_rank() == 0)
-    std::printf("  %d points: contact add() %.2f ms per assembly (search + evaluation + insertion), whole assembly "
-                "%.2f ms (%.0f %%); %d active\n",
-                n, 1e3 * t_contact, 1e3 * t_asm, 100.0 * t_contact / t_asm, contact.last().num_active);
+    std::printf(
+        "  %d points: contact add() %.2f ms per assembly (search + evaluation + insertion), whole assembly "
+        "%.2f ms (%.0f %%); %d active\n",
+        n, 1e3 * t_contact, 1e3 * t_asm, 100.0 * t_contact / t_asm, contact.last().num_active);
   EXPECT_EQ(contact.last().num_active, n);
   participant::ContactReply reply;
   reset_reply(pts, reply);
@@ -360,11 +362,12 @@ TEST(BalloonArtery, ConvergesAndMatchesOnOneAndTwoRanks) {
   const BAResult a = balloon_artery_run(PETSC_COMM_WORLD);
   ASSERT_TRUE(a.converged);
   if (world_rank() == 0)
-    std::printf("  balloon-artery (%d ranks): max|u| = %.9f mm, active %d, min gap %.3e mm, sum|f| = %.9f N, area %.4f\n",
-                world_size(), a.max_u, a.active, a.min_gap, a.force_magnitude, a.area);
+    std::printf(
+        "  balloon-artery (%d ranks): max|u| = %.9f mm, active %d, min gap %.3e mm, sum|f| = %.9f N, area %.4f\n",
+        world_size(), a.max_u, a.active, a.min_gap, a.force_magnitude, a.area);
   EXPECT_GT(a.active, 0);
   EXPECT_LT(a.min_gap, 0.0);
-  EXPECT_GT(a.max_u, 0.05);  // the 0.05 mm radial gap closed
+  EXPECT_GT(a.max_u, 0.05);                              // the 0.05 mm radial gap closed
   EXPECT_LT(a.force, 1e-6 * a.force_magnitude + 1e-12);  // axisymmetric: net force on the artery ~ 0
   if (world_size() > 1) {
     BAResult b;
@@ -390,9 +393,9 @@ TEST(ContactScene, ReadsAndValidates) {
     EXPECT_EQ(s.balloon_artery->penalty, 5.0);
   }
   {
-    const auto s = read_contact_spec(node(
-        "contact: {stent_balloon: {penalty: 20}, stent_artery: off, balloon_artery: {penalty: 7, quadrature: 5}, "
-        "search_radius: 0.2}"));
+    const auto s = read_contact_spec(
+        node("contact: {stent_balloon: {penalty: 20}, stent_artery: off, balloon_artery: {penalty: 7, quadrature: 5}, "
+             "search_radius: 0.2}"));
     EXPECT_EQ(*s.stent_balloon, 20.0);
     EXPECT_FALSE(s.stent_artery);
     EXPECT_EQ(s.balloon_artery->penalty, 7.0);

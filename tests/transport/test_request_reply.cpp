@@ -18,7 +18,10 @@ namespace {
 class BackgroundServer {
  public:
   BackgroundServer(at::Queryable& q, at::Queryable::Handler handler)
-      : thread_([this, &q, handler = std::move(handler)] { q.serve(handler, [this] { return stop_.load(); }, 20ms); }) {}
+      : thread_([this, &q, handler = std::move(handler)] {
+          q.serve(
+              handler, [this] { return stop_.load(); }, 20ms);
+        }) {}
   ~BackgroundServer() {
     stop_ = true;
     thread_.join();
@@ -67,18 +70,15 @@ TEST(TransportRequestReply, UnixSocketSmallAndLargePayloads) {
   exchange_small_and_large(dir.unix_endpoint());
 }
 
-TEST(TransportRequestReply, TcpLoopbackSmallAndLargePayloads) {
-  exchange_small_and_large(tt::free_tcp_endpoint());
-}
+TEST(TransportRequestReply, TcpLoopbackSmallAndLargePayloads) { exchange_small_and_large(tt::free_tcp_endpoint()); }
 
 TEST(TransportRequestReply, HandlerExceptionBecomesRemoteError) {
   tt::TempDir dir;
   const std::string key = tt::unique_prefix("err") + "/coupler/step";
   auto [server, client] = tt::linked_sessions(dir.unix_endpoint());
   auto queryable = server.declare_queryable(key);
-  BackgroundServer bg(queryable, [](const at::IncomingQuery&) -> at::Bytes {
-    throw std::runtime_error("bad step index");
-  });
+  BackgroundServer bg(queryable,
+                      [](const at::IncomingQuery&) -> at::Bytes { throw std::runtime_error("bad step index"); });
   try {
     client.request(key, at::as_bytes("x"), 20s);
     FAIL() << "expected RemoteError";

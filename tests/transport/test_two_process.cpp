@@ -52,6 +52,4 @@ TEST(TransportTwoProcess, HelperConnectsOverUnixSocket) {
   run_exchange(HelperRole::Connects, dir.unix_endpoint());
 }
 
-TEST(TransportTwoProcess, HelperListensOnTcpLoopback) {
-  run_exchange(HelperRole::Listens, tt::free_tcp_endpoint());
-}
+TEST(TransportTwoProcess, HelperListensOnTcpLoopback) { run_exchange(HelperRole::Listens, tt::free_tcp_endpoint()); }

@@ -21,11 +21,16 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     const std::string value = argv[i + 1];
-    if (flag == "--listen") config.listen.push_back(value);
-    else if (flag == "--connect") config.connect.push_back(value);
-    else if (flag == "--key") key = value;
-    else if (flag == "--token") token_key = value;
-    else if (flag == "--max-seconds") max_seconds = std::stoi(value);
+    if (flag == "--listen")
+      config.listen.push_back(value);
+    else if (flag == "--connect")
+      config.connect.push_back(value);
+    else if (flag == "--key")
+      key = value;
+    else if (flag == "--token")
+      token_key = value;
+    else if (flag == "--max-seconds")
+      max_seconds = std::stoi(value);
     else {
       std::cerr << "unknown flag " << flag << "\n";
       return 2;

@@ -8,8 +8,7 @@
 
 namespace angio::cli {
 
-Parser::Parser(std::string program, std::string summary)
-    : program_(std::move(program)), summary_(std::move(summary)) {}
+Parser::Parser(std::string program, std::string summary) : program_(std::move(program)), summary_(std::move(summary)) {}
 
 Parser& Parser::add(Option o) {
   options_.push_back(std::move(o));
@@ -19,10 +18,9 @@ Parser& Parser::add(Option o) {
 Parser& Parser::add_common() {
   add({"scene", "FILE", "scene file (YAML; units mm, N, MPa, s)", ""});
   add({"run-dir", "DIR", "run directory for output (created if missing)", "run"});
-  add({"endpoint", "ENDPOINT",
-       "zenoh endpoint of the coupler, e.g. unixsock-stream//path/c.sock or tcp/127.0.0.1:7447", ""});
-  add({"run-id", "ID", "run id shared by all processes of one run (key prefix, envelope check)",
-       "run"});
+  add({"endpoint", "ENDPOINT", "zenoh endpoint of the coupler, e.g. unixsock-stream//path/c.sock or tcp/127.0.0.1:7447",
+       ""});
+  add({"run-id", "ID", "run id shared by all processes of one run (key prefix, envelope check)", "run"});
   add({"key-file", "FILE",
        "the run's secret key (64 hex digits, mode 0600) that authenticates every message; default <run-dir>/run.key, "
        "which the launcher writes",

@@ -44,8 +44,8 @@ void LoadStepper::reject(const std::string& reason) {
   if (next < s_.min_step * (1.0 - 1e-12) || cuts_ > s_.max_cuts) {
     std::ostringstream os;
     os << "step " << step_ << " from t = " << t_ << " s failed with increment " << dt_
-       << " s and cannot be cut further (time.min_step = " << s_.min_step
-       << " s, time.max_cuts = " << s_.max_cuts << "): " << reason;
+       << " s and cannot be cut further (time.min_step = " << s_.min_step << " s, time.max_cuts = " << s_.max_cuts
+       << "): " << reason;
     throw StepFailure(os.str());
   }
   dt_ = next;

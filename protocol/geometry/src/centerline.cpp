@@ -94,9 +94,7 @@ Vec3 Centerline::radial(double theta, double s) const {
   return std::cos(theta) * f.normal1 + std::sin(theta) * f.normal2;
 }
 
-double Centerline::normal_offset(const Vec3& x, double s) const {
-  return (x - point(s)).dot(frame(s).tangent);
-}
+double Centerline::normal_offset(const Vec3& x, double s) const { return (x - point(s)).dot(frame(s).tangent); }
 
 Centerline::Closest Centerline::closest(const Vec3& x) const {
   // g(s) = (x − c(s))·t(s) is continuous and, within a distance 1/κ of the axis, decreasing
@@ -106,14 +104,15 @@ Centerline::Closest Centerline::closest(const Vec3& x) const {
   std::vector<double> g(m);
   for (int i = 0; i < m; ++i) g[i] = (x - pts_[i]).dot(F_[i].tangent);
   std::vector<double> roots;
-  if (g[0] < 0) roots.push_back(g[0]);                    // before the start: s = s0 + g0
+  if (g[0] < 0) roots.push_back(g[0]);                      // before the start: s = s0 + g0
   if (g[m - 1] > 0) roots.push_back(s_[m - 1] + g[m - 1]);  // beyond the end
   for (int i = 0; i + 1 < m; ++i) {
     if (g[i] == 0) roots.push_back(s_[i]);
     if ((g[i] > 0 && g[i + 1] < 0) || (g[i] < 0 && g[i + 1] > 0)) {
       // bisection: robust and exact to round-off (at most ~60 halvings of one segment)
       double a = s_[i], b = s_[i + 1], ga = g[i];
-      for (int it = 0; it < 200 && b - a > 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(b)); ++it) {
+      for (int it = 0; it < 200 && b - a > 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(b));
+           ++it) {
         const double c = 0.5 * (a + b);
         const double gc = normal_offset(x, c);
         if (gc == 0) {
@@ -165,8 +164,7 @@ std::vector<Vec3> read_centerline_points(const std::string& path) {
     std::istringstream is(line);
     double x, y, z;
     if (!(is >> x)) continue;
-    if (!(is >> y >> z))
-      throw std::runtime_error(path + ":" + std::to_string(ln) + ": expected three numbers x y z");
+    if (!(is >> y >> z)) throw std::runtime_error(path + ":" + std::to_string(ln) + ": expected three numbers x y z");
     pts.emplace_back(x, y, z);
   }
   if (pts.size() < 2) throw std::runtime_error(path + ": centerline needs at least 2 points");

@@ -13,8 +13,7 @@ Buffer finish(FlatBufferBuilder& b, const Header& h, fb::Payload type, Offset<vo
   return Buffer(b.GetBufferPointer(), b.GetBufferPointer() + b.GetSize());
 }
 
-Offset<flatbuffers::Vector<const fb::Vec3*>> vec3s(FlatBufferBuilder& b,
-                                                    const std::vector<participant::Vec3>& v) {
+Offset<flatbuffers::Vector<const fb::Vec3*>> vec3s(FlatBufferBuilder& b, const std::vector<participant::Vec3>& v) {
   // participant::Vec3 is std::array<double,3>: same layout as the fb::Vec3 struct.
   static_assert(sizeof(fb::Vec3) == sizeof(participant::Vec3));
   return b.CreateVectorOfStructs(reinterpret_cast<const fb::Vec3*>(v.data()), v.size());
@@ -37,8 +36,7 @@ Buffer hello(const Header& h, const std::string& software) {
   return finish(b, h, fb::Payload::Hello, p.Union());
 }
 
-Buffer hello_reply(const Header& h, const std::string& software,
-                   const participant::SamplePoints* pts) {
+Buffer hello_reply(const Header& h, const std::string& software, const participant::SamplePoints* pts) {
   FlatBufferBuilder b;
   auto sw = b.CreateString(software);
   Offset<fb::SamplePoints> sp = pts ? points(b, *pts) : Offset<fb::SamplePoints>();
@@ -53,8 +51,7 @@ Buffer step_begin(const Header& h, std::uint32_t step, double time, double dt) {
 }
 
 Buffer beam_solve_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                          const std::vector<participant::Vec3>& line_loads,
-                          const participant::ContactPlanes* planes) {
+                          const std::vector<participant::Vec3>& line_loads, const participant::ContactPlanes* planes) {
   FlatBufferBuilder b(64 + 24 * line_loads.size() + (planes ? 56 * planes->size() : 0));
   const auto q = vec3s(b, line_loads);
   flatbuffers::Offset<flatbuffers::Vector<const fb::Vec3*>> s, n;
@@ -116,8 +113,8 @@ Buffer shutdown(const Header& h, const std::string& reason) {
   return finish(b, h, fb::Payload::Shutdown, p.Union());
 }
 
-Buffer error(const Header& h, const std::string& message, std::uint32_t step,
-             std::uint32_t iteration, const std::vector<double>& history) {
+Buffer error(const Header& h, const std::string& message, std::uint32_t step, std::uint32_t iteration,
+             const std::vector<double>& history) {
   FlatBufferBuilder b;
   auto p = fb::CreateError(b, b.CreateString(message), step, iteration, b.CreateVector(history));
   return finish(b, h, fb::Payload::Error, p.Union());

@@ -21,9 +21,8 @@ participant::SamplePoints to_sample_points(const fb::SamplePoints* p) {
   out.w = to_doubles(p->w());
   out.radius = to_doubles(p->radius());
   if (out.w.size() != out.x.size() || out.radius.size() != out.x.size())
-    throw ProtocolError("sample points disagree in length: " + std::to_string(out.x.size()) +
-                        " positions, " + std::to_string(out.w.size()) + " weights, " +
-                        std::to_string(out.radius.size()) + " radii");
+    throw ProtocolError("sample points disagree in length: " + std::to_string(out.x.size()) + " positions, " +
+                        std::to_string(out.w.size()) + " weights, " + std::to_string(out.radius.size()) + " radii");
   return out;
 }
 
@@ -49,8 +48,7 @@ participant::ContactReply to_contact(const fb::SolidSolveReply& r) {
   if (const auto* d = r.contact()) {
     c.n_active = static_cast<int>(d->n_active());
     c.min_gap = d->min_gap();
-    if (d->total_force())
-      c.total_force = {d->total_force()->x(), d->total_force()->y(), d->total_force()->z()};
+    if (d->total_force()) c.total_force = {d->total_force()->x(), d->total_force()->y(), d->total_force()->z()};
   }
   return c;
 }

@@ -20,7 +20,8 @@ constexpr char kDomain[] = "angio-seal-1";  // separates these tags from any oth
 
 std::string hint(const std::filesystem::path& file) {
   return " (the launcher writes one for each run; for processes started by hand: (umask 077; python3 -c "
-         "'import secrets; print(secrets.token_hex(32))' > " + file.string() + "))";
+         "'import secrets; print(secrets.token_hex(32))' > " +
+         file.string() + "))";
 }
 
 int hex_digit(char c) {
@@ -38,8 +39,8 @@ RunKey RunKey::read(const std::filesystem::path& file) {
     throw KeyFileError(file.string() + ": expected the run's key file, got " + std::strerror(errno) + hint(file));
   if (!S_ISREG(st.st_mode)) throw KeyFileError(file.string() + ": expected a regular file (the run's key file)");
   if (st.st_uid != ::geteuid())
-    throw KeyFileError(file.string() + ": expected a key file owned by this user (uid " +
-                       std::to_string(::geteuid()) + "), got uid " + std::to_string(st.st_uid));
+    throw KeyFileError(file.string() + ": expected a key file owned by this user (uid " + std::to_string(::geteuid()) +
+                       "), got uid " + std::to_string(st.st_uid));
   if (st.st_mode & 077) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
@@ -58,7 +59,8 @@ RunKey RunKey::read(const std::filesystem::path& file) {
     ok = hi >= 0 && lo >= 0;
     secret[i] = static_cast<std::uint8_t>(16 * hi + lo);
   }
-  if (!ok) throw KeyFileError(file.string() + ": expected one line of " + std::to_string(2 * kKeyBytes) + " hex digits");
+  if (!ok)
+    throw KeyFileError(file.string() + ": expected one line of " + std::to_string(2 * kKeyBytes) + " hex digits");
   RunKey key(secret);
   OPENSSL_cleanse(secret.data(), secret.size());
   return key;
@@ -71,7 +73,8 @@ std::array<std::uint8_t, RunKey::kTagBytes> RunKey::tag_(std::span<const std::ui
   data.insert(data.end(), kDomain, kDomain + sizeof kDomain - 1);
   data.insert(data.end(), envelope.begin(), envelope.end());
   unsigned int len = 0;
-  if (!HMAC(EVP_sha256(), secret_.data(), static_cast<int>(secret_.size()), data.data(), data.size(), tag.data(), &len) ||
+  if (!HMAC(EVP_sha256(), secret_.data(), static_cast<int>(secret_.size()), data.data(), data.size(), tag.data(),
+            &len) ||
       len != kTagBytes)
     throw std::runtime_error("HMAC-SHA256 failed");
   return tag;
@@ -89,8 +92,9 @@ std::optional<std::span<const std::uint8_t>> RunKey::verified(std::span<const st
   const auto envelope = sealed.first(sealed.size() - kTagBytes);
   try {
     const auto tag = tag_(envelope);
-    if (CRYPTO_memcmp(tag.data(), sealed.data() + envelope.size(), kTagBytes) != 0) return std::nullopt;  // constant time
-  } catch (...) {  // HMAC failure (allocation): not verified
+    if (CRYPTO_memcmp(tag.data(), sealed.data() + envelope.size(), kTagBytes) != 0)
+      return std::nullopt;  // constant time
+  } catch (...) {           // HMAC failure (allocation): not verified
     return std::nullopt;
   }
   return envelope;
@@ -98,10 +102,12 @@ std::optional<std::span<const std::uint8_t>> RunKey::verified(std::span<const st
 
 std::span<const std::uint8_t> RunKey::unseal(std::span<const std::uint8_t> sealed) const {
   if (sealed.size() <= kTagBytes)
-    throw ProtocolError("message of " + std::to_string(sealed.size()) + " bytes is too short to carry an authentication tag");
+    throw ProtocolError("message of " + std::to_string(sealed.size()) +
+                        " bytes is too short to carry an authentication tag");
   if (const auto envelope = verified(sealed)) return *envelope;
-  throw ProtocolError("message is not authenticated by the run's key (a process without the run's key file, "
-                      "or altered on the way)");
+  throw ProtocolError(
+      "message is not authenticated by the run's key (a process without the run's key file, "
+      "or altered on the way)");
 }
 
 }  // namespace angio::msg

@@ -27,8 +27,9 @@ void StepState::check(const fb::Envelope& env) {
     case fb::Payload::StepBegin: {
       const auto& s = *env.payload_as_StepBegin();
       if (!std::isfinite(s.time()) || !std::isfinite(s.dt()) || s.dt() < 0.0)
-        throw ProtocolError("StepBegin for step " + std::to_string(s.step()) + " with time " + std::to_string(s.time()) +
-                            " and increment " + std::to_string(s.dt()) + " (expected finite values, increment >= 0)");
+        throw ProtocolError("StepBegin for step " + std::to_string(s.step()) + " with time " +
+                            std::to_string(s.time()) + " and increment " + std::to_string(s.dt()) +
+                            " (expected finite values, increment >= 0)");
       if (open_)
         throw ProtocolError("StepBegin for step " + std::to_string(s.step()) + " while step " + std::to_string(step_) +
                             " is open (no StepEnd)");
@@ -36,7 +37,9 @@ void StepState::check(const fb::Envelope& env) {
       step_ = s.step();
       return;
     }
-    case fb::Payload::BeamSolveRequest: in_this_step(env.payload_as_BeamSolveRequest()->step()); return;
+    case fb::Payload::BeamSolveRequest:
+      in_this_step(env.payload_as_BeamSolveRequest()->step());
+      return;
     case fb::Payload::SolidSolveRequest: {
       const auto& r = *env.payload_as_SolidSolveRequest();
       in_this_step(r.step());
@@ -49,7 +52,8 @@ void StepState::check(const fb::Envelope& env) {
       in_this_step(env.payload_as_StepEnd()->step());
       open_ = false;
       return;
-    default: return;  // anything else is the dispatcher's to refuse
+    default:
+      return;  // anything else is the dispatcher's to refuse
   }
 }
 

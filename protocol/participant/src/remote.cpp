@@ -10,8 +10,7 @@
 
 namespace angio::participant {
 
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 Channel::Channel(const transport::Session& session, std::string run_id, fb::Role role,
                  std::chrono::milliseconds timeout, recording::Recorder* recorder, msg::RunKey key)
@@ -70,12 +69,11 @@ msg::Buffer Channel::call(const Build& build) {
     env = &msg::open(reply, run_id_);
     sequence_.check_reply(*env, seq);
   } catch (const msg::ProtocolError& e) {
-    throw ParticipantError("bad reply from the " + role_name_ + " participant to '" + verb +
-                           "': " + e.what());
+    throw ParticipantError("bad reply from the " + role_name_ + " participant to '" + verb + "': " + e.what());
   }
   if (env->sender() != role_)
-    throw ParticipantError("reply to '" + verb + "' came from role " +
-                           msg::role_name(env->sender()) + ", expected " + role_name_);
+    throw ParticipantError("reply to '" + verb + "' came from role " + msg::role_name(env->sender()) + ", expected " +
+                           role_name_);
   if (const auto* err = env->payload_as_Error())
     throw ParticipantError("the " + role_name_ + " participant failed on '" + verb +
                            "': " + flatbuffers::GetString(err->message()));
@@ -99,8 +97,7 @@ std::string RemoteBeam::hello() {
   auto b = ch_.call([](const msg::Header& h) { return msg::hello(h, "coupler"); });
   const auto& r = reply_as<fb::HelloReply>(b);
   if (r.protocol_version() != msg::kProtocolVersion)
-    throw ParticipantError("beam participant speaks protocol " +
-                           std::to_string(r.protocol_version()));
+    throw ParticipantError("beam participant speaks protocol " + std::to_string(r.protocol_version()));
   points_ = msg::to_sample_points(r.sample_points());
   return flatbuffers::GetString(r.software());
 }
@@ -118,15 +115,13 @@ SolveStats RemoteBeam::solve_with_planes(const std::vector<Vec3>& q, const Conta
 }
 
 SolveStats RemoteBeam::solve_(const std::vector<Vec3>& q, const ContactPlanes* planes) {
-  auto b = ch_.call([&](const msg::Header& h) {
-    return msg::beam_solve_request(h, step_, iteration_, q, planes);
-  });
+  auto b = ch_.call([&](const msg::Header& h) { return msg::beam_solve_request(h, step_, iteration_, q, planes); });
   const auto& r = reply_as<fb::BeamSolveReply>(b);
   account(ch_, r.stats());
   SamplePoints pts = msg::to_sample_points(r.sample_points());
   if (pts.size() != points_.size())
-    throw ParticipantError("beam participant returned " + std::to_string(pts.size()) +
-                           " sample points, announced " + std::to_string(points_.size()));
+    throw ParticipantError("beam participant returned " + std::to_string(pts.size()) + " sample points, announced " +
+                           std::to_string(points_.size()));
   points_ = std::move(pts);
   return msg::to_stats(r.stats());
 }
@@ -143,8 +138,7 @@ std::string RemoteSolid::hello() {
   auto b = ch_.call([](const msg::Header& h) { return msg::hello(h, "coupler"); });
   const auto& r = reply_as<fb::HelloReply>(b);
   if (r.protocol_version() != msg::kProtocolVersion)
-    throw ParticipantError("solid participant speaks protocol " +
-                           std::to_string(r.protocol_version()));
+    throw ParticipantError("solid participant speaks protocol " + std::to_string(r.protocol_version()));
   return flatbuffers::GetString(r.software());
 }
 
@@ -155,9 +149,8 @@ void RemoteSolid::begin_step(int step, double time) {
 }
 
 SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply, double tolerance) {
-  auto b = ch_.call([&](const msg::Header& h) {
-    return msg::solid_solve_request(h, step_, iteration_, pts, tolerance);
-  });
+  auto b =
+      ch_.call([&](const msg::Header& h) { return msg::solid_solve_request(h, step_, iteration_, pts, tolerance); });
   const auto& r = reply_as<fb::SolidSolveReply>(b);
   account(ch_, r.stats());
   reply = msg::to_contact(r);

@@ -48,8 +48,7 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
         if (ev->alive) {
           coupler_seen = true;
         } else if (coupler_seen) {
-          LOG_ERROR("the coupler disappeared (its liveliness token " << ev->key
-                                                                      << " is gone); exiting");
+          LOG_ERROR("the coupler disappeared (its liveliness token " << ev->key << " is gone); exiting");
           return 4;
         }
       }
@@ -96,16 +95,14 @@ int serve_role(fb::Role role, const ServeOptions& o, const Dispatch& dispatch) {
   }
 }
 
-msg::Buffer common(const fb::Envelope& env, const msg::Header& h, bool& stop,
-                   const std::function<void()>& finish) {
+msg::Buffer common(const fb::Envelope& env, const msg::Header& h, bool& stop, const std::function<void()>& finish) {
   if (env.payload_type() == fb::Payload::Shutdown) {
     LOG_DEBUG("shutdown: " << flatbuffers::GetString(env.payload_as_Shutdown()->reason()));
     finish();
     stop = true;
     return msg::ack(h);
   }
-  throw msg::ProtocolError(std::string("unexpected ") + msg::payload_name(env.payload_type()) +
-                           " request");
+  throw msg::ProtocolError(std::string("unexpected ") + msg::payload_name(env.payload_type()) + " request");
 }
 
 }  // namespace
@@ -144,8 +141,7 @@ int serve(BeamParticipant& beam, const ServeOptions& o) {
         const std::size_t n = beam.sample_points().size();
         if (q.size() != n)
           throw msg::ProtocolError("BeamSolveRequest carries " + std::to_string(q.size()) +
-                                   " line loads, the stent has " + std::to_string(n) +
-                                   " sample points");
+                                   " line loads, the stent has " + std::to_string(n) + " sample points");
         // Robin mode when the request carries contact planes (all three vectors, K per point).
         ContactPlanes planes;
         planes.s = msg::to_vec3s(r.surface_points());
@@ -157,9 +153,8 @@ int serve(BeamParticipant& beam, const ServeOptions& o) {
             (planes_per_point(planes.eps.size(), n) == 0 || planes.s.size() != planes.eps.size() ||
              planes.n.size() != planes.eps.size()))
           throw msg::ProtocolError("BeamSolveRequest carries contact planes of sizes " +
-                                   std::to_string(planes.s.size()) + "/" + std::to_string(planes.n.size()) +
-                                   "/" + std::to_string(planes.eps.size()) + ", expected K x " +
-                                   std::to_string(n) + " each");
+                                   std::to_string(planes.s.size()) + "/" + std::to_string(planes.n.size()) + "/" +
+                                   std::to_string(planes.eps.size()) + ", expected K x " + std::to_string(n) + " each");
         const auto t0 = Clock::now();
         SolveStats stats = robin ? beam.solve_with_planes(q, planes) : beam.solve(q);
         return msg::beam_solve_reply(h, stats, seconds_since(t0), beam.sample_points());

@@ -23,19 +23,17 @@ int run(const scene::TimeSettings& time, const std::function<void(int, double)>&
       begin(stepper.step(), stepper.time());
       SolveStats s = solve();
       if (!s.converged) {
-        LOG_WARN("step " << stepper.step() << " t = " << stepper.time() << " s: not converged after "
-                         << s.iterations << " iterations (" << s.message << "), " << history(s)
-                         << "; cutting the step");
+        LOG_WARN("step " << stepper.step() << " t = " << stepper.time() << " s: not converged after " << s.iterations
+                         << " iterations (" << s.message << "), " << history(s) << "; cutting the step");
         end(false);
         stepper.reject(s.message + ", " + history(s));
         continue;
       }
       end(true);
-      const double wall =
-          seconds_since(t0);
+      const double wall = seconds_since(t0);
       // The participant logs its own line per committed step (with its physical measures).
       LOG_DEBUG("step " << stepper.step() << " t = " << stepper.time() << " s: " << s.iterations
-                       << " Newton iterations, residual " << s.residual << ", " << wall << " s");
+                        << " Newton iterations, residual " << s.residual << ", " << wall << " s");
       stepper.accept(s.iterations);
     }
   } catch (const StepFailure& e) {
@@ -62,9 +60,8 @@ int run_standalone(BeamParticipant& beam, const scene::TimeSettings& time) {
 int run_standalone(SolidParticipant& solid, const scene::TimeSettings& time) {
   ContactReply reply;
   return run(
-      time, [&](int n, double t) { solid.begin_step(n, t); },
-      [&] { return solid.solve(SamplePoints{}, reply, 0.0); }, [&](bool a) { solid.end_step(a); },
-      [&] { solid.finish(); });
+      time, [&](int n, double t) { solid.begin_step(n, t); }, [&] { return solid.solve(SamplePoints{}, reply, 0.0); },
+      [&](bool a) { solid.end_step(a); }, [&] { solid.finish(); });
 }
 
 }  // namespace angio::participant

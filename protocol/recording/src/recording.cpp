@@ -54,8 +54,7 @@ Recorder::Recorder(const std::string& path, const std::string& run_id)
   out_.flush();
 }
 
-void Recorder::add(fb::Role role, const std::string& verb, const msg::Buffer& request,
-                   const msg::Buffer& reply) {
+void Recorder::add(fb::Role role, const std::string& verb, const msg::Buffer& request, const msg::Buffer& reply) {
   put(out_, static_cast<std::uint8_t>(role));
   put(out_, static_cast<std::uint16_t>(verb.size()));
   out_.write(verb.data(), static_cast<std::streamsize>(verb.size()));

@@ -22,8 +22,8 @@ namespace {
 // coupler consumes; throws if the kind of reply differs.
 double deviation(const fb::Envelope& live, const fb::Envelope& rec) {
   if (live.payload_type() != rec.payload_type())
-    throw replay::ReplayMismatch(std::string("reply is a ") + msg::payload_name(live.payload_type()) +
-                                 ", recorded a " + msg::payload_name(rec.payload_type()));
+    throw replay::ReplayMismatch(std::string("reply is a ") + msg::payload_name(live.payload_type()) + ", recorded a " +
+                                 msg::payload_name(rec.payload_type()));
   if (auto* b = live.payload_as_BeamSolveReply()) {
     auto* r = rec.payload_as_BeamSolveReply();
     if (b->stats()->converged() != r->stats()->converged())
@@ -76,18 +76,17 @@ int main(int argc, char** argv) {
       session.request(key_expr, key.seal(e.request), timeout, authentic);
       const fb::Envelope& live = msg::open(live_bytes, rec.run_id);
       if (const auto* err = live.payload_as_Error())
-        throw replay::ReplayMismatch("exchange " + std::to_string(n) + ": participant error: " +
-                                     flatbuffers::GetString(err->message()));
+        throw replay::ReplayMismatch("exchange " + std::to_string(n) +
+                                     ": participant error: " + flatbuffers::GetString(err->message()));
       const double d = deviation(live, msg::open(e.reply, rec.run_id));
       worst = std::max(worst, d);
       if (!(d <= tol))
-        throw replay::ReplayMismatch("exchange " + std::to_string(n) + " (" + e.verb +
-                                     "): reply deviates by " + std::to_string(d) +
-                                     " (relative), tolerance " + std::to_string(tol));
+        throw replay::ReplayMismatch("exchange " + std::to_string(n) + " (" + e.verb + "): reply deviates by " +
+                                     std::to_string(d) + " (relative), tolerance " + std::to_string(tol));
       ++n;
     }
-    LOG_INFO(n << " exchanges replayed against the " << role << " participant; largest relative deviation "
-               << worst << " (tolerance " << tol << ")");
+    LOG_INFO(n << " exchanges replayed against the " << role << " participant; largest relative deviation " << worst
+               << " (tolerance " << tol << ")");
     return 0;
   });
 }

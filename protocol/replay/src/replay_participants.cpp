@@ -27,17 +27,15 @@ const fb::Envelope& Cursor::next(fb::Payload expected) {
                          " exchanges of role " + msg::role_name(role_) + ")");
   const fb::Envelope& req = msg::open(items_[pos_]->request, run_id_);
   if (req.payload_type() != expected)
-    throw ReplayMismatch("exchange " + std::to_string(pos_) + " of role " + msg::role_name(role_) +
-                         ": received a " + msg::payload_name(expected) + " request, recorded a " +
-                         msg::payload_name(req.payload_type()));
+    throw ReplayMismatch("exchange " + std::to_string(pos_) + " of role " + msg::role_name(role_) + ": received a " +
+                         msg::payload_name(expected) + " request, recorded a " + msg::payload_name(req.payload_type()));
   ++pos_;
   return req;
 }
 
 const fb::Envelope& Cursor::reply() const { return msg::open(items_.at(pos_ - 1)->reply, run_id_); }
 
-double relative_difference(const std::vector<participant::Vec3>& a,
-                           const std::vector<participant::Vec3>& b) {
+double relative_difference(const std::vector<participant::Vec3>& a, const std::vector<participant::Vec3>& b) {
   if (a.size() != b.size()) return INFINITY;
   double scale = 1.0, diff = 0.0;
   for (std::size_t i = 0; i < b.size(); ++i)
@@ -61,8 +59,8 @@ void check_step(const Cursor& c, const fb::StepBegin& rec, int step, double time
 
 void check_end(const Cursor& c, const fb::StepEnd& rec, bool accept) {
   if (rec.accept() != accept)
-    throw ReplayMismatch("exchange " + std::to_string(c.position() - 1) + ": StepEnd(accept = " +
-                         (accept ? "true" : "false") + ") but the recording " +
+    throw ReplayMismatch("exchange " + std::to_string(c.position() - 1) +
+                         ": StepEnd(accept = " + (accept ? "true" : "false") + ") but the recording " +
                          (rec.accept() ? "accepted" : "rejected") + " the step");
 }
 
@@ -71,8 +69,8 @@ void check_vectors(const Cursor& c, const char* what, const std::vector<particip
   const double d = relative_difference(got, rec);
   if (!(d <= tol)) {
     std::ostringstream os;
-    os << "exchange " << c.position() - 1 << ": " << what << " differ from the recording by "
-       << d << " (relative), tolerance " << tol;
+    os << "exchange " << c.position() - 1 << ": " << what << " differ from the recording by " << d
+       << " (relative), tolerance " << tol;
     if (got.size() != rec.size()) os << " (" << got.size() << " vs " << rec.size() << " points)";
     throw ReplayMismatch(os.str());
   }
@@ -91,8 +89,7 @@ void check_scalar(const Cursor& c, const char* what, double got, double rec, dou
 
 }  // namespace
 
-ReplayBeam::ReplayBeam(const recording::Recording& rec, double tol)
-    : cursor_(rec, fb::Role::Beam), tol_(tol) {
+ReplayBeam::ReplayBeam(const recording::Recording& rec, double tol) : cursor_(rec, fb::Role::Beam), tol_(tol) {
   cursor_.next(fb::Payload::Hello);
   points_ = msg::to_sample_points(msg::payload_as<fb::HelloReply>(cursor_.reply()).sample_points());
 }
@@ -115,8 +112,7 @@ void ReplayBeam::end_step(bool accept) {
 
 void ReplayBeam::finish() { cursor_.next(fb::Payload::Shutdown); }
 
-ReplaySolid::ReplaySolid(const recording::Recording& rec, double tol)
-    : cursor_(rec, fb::Role::Solid), tol_(tol) {
+ReplaySolid::ReplaySolid(const recording::Recording& rec, double tol) : cursor_(rec, fb::Role::Solid), tol_(tol) {
   cursor_.next(fb::Payload::Hello);
 }
 
@@ -124,8 +120,8 @@ void ReplaySolid::begin_step(int step, double time) {
   check_step(cursor_, *cursor_.next(fb::Payload::StepBegin).payload_as_StepBegin(), step, time);
 }
 
-participant::SolveStats ReplaySolid::solve(const participant::SamplePoints& pts,
-                                           participant::ContactReply& reply, double tolerance) {
+participant::SolveStats ReplaySolid::solve(const participant::SamplePoints& pts, participant::ContactReply& reply,
+                                           double tolerance) {
   const auto& req = *cursor_.next(fb::Payload::SolidSolveRequest).payload_as_SolidSolveRequest();
   const participant::SamplePoints rec = msg::to_sample_points(req.sample_points());
   check_vectors(cursor_, "sample-point positions", pts.x, rec.x, tol_);

@@ -101,8 +101,9 @@ TimeSettings time_settings(const Node& root) {
     a->check_keys({"max_step", "easy_iterations"});
     ts.max_step = a->number("max_step");
     if (!(ts.max_step > nominal * (1.0 + 1e-12) && ts.max_step <= ts.end - ts.start))
-      a->child("max_step").fail("a step larger than the nominal one ((end - start)/steps = " + std::to_string(nominal) +
-                                " s) and at most end - start");
+      a->child("max_step")
+          .fail("a step larger than the nominal one ((end - start)/steps = " + std::to_string(nominal) +
+                " s) and at most end - start");
     const long easy = a->integer_or("easy_iterations", ts.easy_iterations, 1);
     if (easy > 1000) a->child("easy_iterations").fail("at most 1000 iterations");
     ts.easy_iterations = static_cast<int>(easy);

@@ -12,9 +12,7 @@ namespace angio::scene {
 Node::Node(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
-std::string Node::child_path(const std::string& key) const {
-  return path_.empty() ? key : path_ + "." + key;
-}
+std::string Node::child_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
 std::string Node::got() const {
   if (!node_.IsDefined() || node_.IsNull()) return "nothing";
@@ -30,9 +28,7 @@ void Node::fail(const std::string& expected) const {
   throw SceneError(msg);
 }
 
-bool Node::has(const std::string& key) const {
-  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
-}
+bool Node::has(const std::string& key) const { return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull(); }
 
 Node Node::child(const std::string& key, const std::string& what) const {
   if (!node_.IsMap()) fail("a map containing '" + key + "'");
@@ -104,9 +100,7 @@ std::array<double, 3> Node::as_vec3() const {
 
 double Node::number(const std::string& key) const { return child(key, "a number").as_number(); }
 
-double Node::number_or(const std::string& key, double fallback) const {
-  return has(key) ? number(key) : fallback;
-}
+double Node::number_or(const std::string& key, double fallback) const { return has(key) ? number(key) : fallback; }
 
 double Node::positive(const std::string& key) const {
   Node c = child(key, "a positive number");
@@ -115,9 +109,7 @@ double Node::positive(const std::string& key) const {
   return v;
 }
 
-double Node::positive_or(const std::string& key, double fallback) const {
-  return has(key) ? positive(key) : fallback;
-}
+double Node::positive_or(const std::string& key, double fallback) const { return has(key) ? positive(key) : fallback; }
 
 double Node::non_negative(const std::string& key) const {
   Node c = child(key, "a non-negative number");
@@ -168,13 +160,9 @@ bool Node::boolean(const std::string& key) const {
   }
 }
 
-bool Node::boolean_or(const std::string& key, bool fallback) const {
-  return has(key) ? boolean(key) : fallback;
-}
+bool Node::boolean_or(const std::string& key, bool fallback) const { return has(key) ? boolean(key) : fallback; }
 
-std::string Node::string(const std::string& key) const {
-  return child(key, "a string").as_string();
-}
+std::string Node::string(const std::string& key) const { return child(key, "a string").as_string(); }
 
 std::string Node::string_or(const std::string& key, const std::string& fallback) const {
   return has(key) ? string(key) : fallback;
@@ -203,9 +191,7 @@ std::array<double, 3> Node::vec3(const std::string& key) const {
   return child(key, "a list of 3 numbers [x, y, z]").as_vec3();
 }
 
-std::vector<double> Node::numbers(const std::string& key) const {
-  return child(key, "a list of numbers").as_numbers();
-}
+std::vector<double> Node::numbers(const std::string& key) const { return child(key, "a list of numbers").as_numbers(); }
 
 std::vector<long> Node::integers(const std::string& key) const {
   Node c = child(key, "a list of integers");
@@ -281,14 +267,13 @@ void Node::check_keys(const std::vector<std::string>& allowed) const {
 }
 
 Node load_scene(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path))
-    throw SceneError(path + ": cannot open scene file (no such file)");
+  if (!std::filesystem::is_regular_file(path)) throw SceneError(path + ": cannot open scene file (no such file)");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::Exception& e) {
-    throw SceneError(path + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) +
-                     ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+    throw SceneError(path + ": YAML syntax error at line " + std::to_string(e.mark.line + 1) + ", column " +
+                     std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   Node n(root, path, "");
   if (!root.IsMap()) n.fail("a YAML map at the top level");

@@ -11,9 +11,7 @@ void ShimRelease::operator()(az_query* q) const noexcept { az_query_drop(q); }
 void ShimRelease::operator()(az_publisher* p) const noexcept { az_publisher_drop(p); }
 void ShimRelease::operator()(az_subscriber* s) const noexcept { az_subscriber_drop(s); }
 void ShimRelease::operator()(az_token* t) const noexcept { az_liveliness_token_drop(t); }
-void ShimRelease::operator()(az_liveliness_subscriber* s) const noexcept {
-  az_liveliness_subscriber_drop(s);
-}
+void ShimRelease::operator()(az_liveliness_subscriber* s) const noexcept { az_liveliness_subscriber_drop(s); }
 
 std::string last_error() {
   const char* msg = az_last_error();

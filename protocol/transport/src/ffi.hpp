@@ -28,11 +28,10 @@ inline void check(int rc, std::string_view what, std::string_view key) {
 // overflow deadline arithmetic.
 inline std::chrono::milliseconds clamp_timeout(std::chrono::milliseconds d) {
   constexpr std::chrono::milliseconds max_timeout = std::chrono::hours(24 * 30);
-  return d < std::chrono::milliseconds::zero() ? std::chrono::milliseconds::zero() : (d > max_timeout ? max_timeout : d);
+  return d < std::chrono::milliseconds::zero() ? std::chrono::milliseconds::zero()
+                                               : (d > max_timeout ? max_timeout : d);
 }
 
-inline std::uint64_t to_ms(std::chrono::milliseconds d) {
-  return static_cast<std::uint64_t>(clamp_timeout(d).count());
-}
+inline std::uint64_t to_ms(std::chrono::milliseconds d) { return static_cast<std::uint64_t>(clamp_timeout(d).count()); }
 
 }  // namespace angio::transport::detail

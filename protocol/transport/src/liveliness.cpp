@@ -8,8 +8,7 @@ namespace angio::transport {
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
 
-LivelinessToken::LivelinessToken(az_token* handle, std::string key)
-    : handle_(handle), key_(std::move(key)) {}
+LivelinessToken::LivelinessToken(az_token* handle, std::string key) : handle_(handle), key_(std::move(key)) {}
 
 LivelinessWatcher::LivelinessWatcher(az_liveliness_subscriber* handle, std::string key)
     : handle_(handle), key_(std::move(key)) {}

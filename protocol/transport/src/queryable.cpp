@@ -7,8 +7,7 @@
 
 namespace angio::transport {
 
-IncomingQuery::IncomingQuery(az_query* handle, OwnedBuffer payload)
-    : handle_(handle), payload_(std::move(payload)) {}
+IncomingQuery::IncomingQuery(az_query* handle, OwnedBuffer payload) : handle_(handle), payload_(std::move(payload)) {}
 
 std::string_view IncomingQuery::key() const {
   const char* k = handle_ ? az_query_keyexpr(handle_.get()) : nullptr;

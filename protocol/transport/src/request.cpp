@@ -20,9 +20,8 @@ using std::chrono::milliseconds;
 constexpr milliseconds no_route_backoff{20};
 
 std::string timeout_message(const std::string& key, milliseconds timeout, bool route_seen) {
-  return "request to '" + key + "' got no reply within " + std::to_string(timeout.count()) +
-         " ms (" + (route_seen ? "the queryable did not answer in time" : "no queryable reachable on this key") +
-         ")";
+  return "request to '" + key + "' got no reply within " + std::to_string(timeout.count()) + " ms (" +
+         (route_seen ? "the queryable did not answer in time" : "no queryable reachable on this key") + ")";
 }
 
 // The C callback in front of Session::Accept: exceptions must not cross into Rust.
@@ -40,9 +39,9 @@ int accept_trampoline(void* ctx, const std::uint8_t* data, std::size_t len) {
 std::optional<Bytes> attempt(az_session* s, const std::string& key, ByteView payload, milliseconds wait,
                              milliseconds timeout, const Session::Accept& accept = {}) {
   az_bytes raw{nullptr, 0};
-  const int rc = az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(wait),
-                            accept ? accept_trampoline : nullptr,
-                            accept ? const_cast<Session::Accept*>(&accept) : nullptr, &raw);
+  const int rc =
+      az_request(s, key.c_str(), payload.data(), payload.size(), detail::to_ms(wait),
+                 accept ? accept_trampoline : nullptr, accept ? const_cast<Session::Accept*>(&accept) : nullptr, &raw);
   const OwnedBuffer reply = OwnedBuffer::adopt(raw);
   switch (rc) {
     case AZ_OK:

@@ -28,8 +28,8 @@ std::string describe(const SessionConfig& c) {
 
 // Shared body of the declare_* functions whose shim call takes (session, key, out).
 template <class Entity, class Raw>
-Entity declare(az_session* s, const std::string& key,
-               int (*shim_declare)(const az_session*, const char*, Raw**), std::string_view what) {
+Entity declare(az_session* s, const std::string& key, int (*shim_declare)(const az_session*, const char*, Raw**),
+               std::string_view what) {
   Raw* handle = nullptr;
   detail::check(shim_declare(s, key.c_str(), &handle), what, key);
   return Entity(handle, key);
@@ -80,15 +80,13 @@ LivelinessToken Session::declare_liveliness_token(const std::string& key) const 
 
 LivelinessWatcher Session::watch_liveliness(const std::string& key) const {
   az_liveliness_subscriber* s = nullptr;
-  detail::check(az_liveliness_subscriber_declare(checked(), key.c_str(), /*history=*/1, &s),
-                "watch_liveliness", key);
+  detail::check(az_liveliness_subscriber_declare(checked(), key.c_str(), /*history=*/1, &s), "watch_liveliness", key);
   return LivelinessWatcher(s, key);
 }
 
 bool Session::liveliness_alive(const std::string& key, std::chrono::milliseconds timeout) const {
   std::size_t count = 0;
-  detail::check(az_liveliness_count(checked(), key.c_str(), detail::to_ms(timeout), &count),
-                "liveliness query", key);
+  detail::check(az_liveliness_count(checked(), key.c_str(), detail::to_ms(timeout), &count), "liveliness query", key);
   return count > 0;
 }
 

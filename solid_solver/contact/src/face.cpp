@@ -8,9 +8,12 @@ namespace angio::contact {
 
 int num_nodes(FaceKind k) {
   switch (k) {
-    case FaceKind::Quad4: return 4;
-    case FaceKind::Tri3: return 3;
-    case FaceKind::Tri6: return 6;
+    case FaceKind::Quad4:
+      return 4;
+    case FaceKind::Tri3:
+      return 3;
+    case FaceKind::Tri6:
+      return 6;
   }
   return 0;
 }
@@ -19,9 +22,12 @@ int num_corners(FaceKind k) { return k == FaceKind::Quad4 ? 4 : 3; }
 
 const char* name(FaceKind k) {
   switch (k) {
-    case FaceKind::Quad4: return "quad4";
-    case FaceKind::Tri3: return "tri3";
-    case FaceKind::Tri6: return "tri6";
+    case FaceKind::Quad4:
+      return "quad4";
+    case FaceKind::Tri3:
+      return "tri3";
+    case FaceKind::Tri6:
+      return "tri6";
   }
   return "?";
 }

@@ -18,8 +18,8 @@ void ContactDiagnostics::merge(const ContactDiagnostics& o) {
 }
 
 namespace {
-using participant::PenaltyLaw;
 using participant::penalty_law;  // the one law of the stent's line contact, shared with the robin planes
+using participant::PenaltyLaw;
 
 // Common start of both point kernels: the gap g = d − R, activity g < g0, everything reset (r: 3 nn,
 // K: 3 nn x k_cols). Returns the penalty law at g if the point is active.
@@ -118,14 +118,15 @@ void chain_normals(const Face& face, const SurfaceSearch& S, NodalContribution& 
   for (int b = 0; b < nn; ++b) {
     const NodeNormal& nb = S.node_normal(face.nodes[b]);
     const auto Kn = nc.K.middleCols<3>(3 * nn + 3 * b);
-    for (std::size_t j = 0; j < nb.ring.size(); ++j) K.middleCols<3>(3 * index(nb.ring[j])) += Kn * nb.dn.middleCols<3>(3 * j);
+    for (std::size_t j = 0; j < nb.ring.size(); ++j)
+      K.middleCols<3>(3 * index(nb.ring[j])) += Kn * nb.dn.middleCols<3>(3 * j);
   }
   nc.K = std::move(K);
 }
 }  // namespace
 
-LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::span<const SurfaceSearch* const> surfaces,
-                                        const LineContactParams& par) {
+LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
+                                        std::span<const SurfaceSearch* const> surfaces, const LineContactParams& par) {
   LineContactResult res;
   res.q.assign(points.size(), Vec3::Zero());
   res.per_surface.resize(surfaces.size());
@@ -150,7 +151,8 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::
         const SurfaceProjection sp = S.closest(bp.x, par.projection);
         if (!sp.found) continue;
         pc.face = sp.face;
-        line_point_kernel(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), surf.normal_sign, sp.proj, par, pc, nc.r, K);
+        line_point_kernel(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), surf.normal_sign, sp.proj, par, pc,
+                          nc.r, K);
       }
       pc.found = true;
       const Face& face = surf.faces[pc.face];

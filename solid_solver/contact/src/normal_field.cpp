@@ -87,7 +87,8 @@ NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const Fa
     alpha += dy[2];
     p.iterations = it + 1;
     if (!xi.allFinite() || xi.lpNorm<Eigen::Infinity>() > 10.0) return p;
-    if (dy.head<2>().lpNorm<Eigen::Infinity>() < 1e-13 && std::abs(dy[2]) * m.norm() < 1e-13 * (1.0 + std::abs(alpha))) {
+    if (dy.head<2>().lpNorm<Eigen::Infinity>() < 1e-13 &&
+        std::abs(dy[2]) * m.norm() < 1e-13 * (1.0 + std::abs(alpha))) {
       shape(k, xi, N, &dN);
       m = Nn * N;
       p.xi = xi;

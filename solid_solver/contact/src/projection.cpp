@@ -8,9 +8,12 @@ namespace angio::contact {
 
 const char* name(Location l) {
   switch (l) {
-    case Location::Interior: return "interior";
-    case Location::Edge: return "edge";
-    case Location::Corner: return "corner";
+    case Location::Interior:
+      return "interior";
+    case Location::Edge:
+      return "edge";
+    case Location::Corner:
+      return "corner";
   }
   return "?";
 }
@@ -35,7 +38,8 @@ struct EdgeMin {
 };
 
 // Minimize f(t) = |x - x_s(A + t D)|^2 / 2 over t in [0, 1] (clamped Newton with backtracking).
-EdgeMin edge_min(FaceKind k, const FaceX& X, const Vec3& x, const Vec2& A, const Vec2& D, const ProjectionOptions& opt) {
+EdgeMin edge_min(FaceKind k, const FaceX& X, const Vec3& x, const Vec2& A, const Vec2& D,
+                 const ProjectionOptions& opt) {
   EdgeMin best;
   for (double t0 : {0.0, 0.25, 0.5, 0.75, 1.0}) {
     const double f = half_dist2(k, X, A + t0 * D, x);
@@ -81,11 +85,12 @@ EdgeMin edge_min(FaceKind k, const FaceX& X, const Vec3& x, const Vec2& A, const
 Projection project(FaceKind k, const FaceX& X, double normal_sign, const Vec3& x, const ProjectionOptions& opt) {
   Projection p;
   // Robust start: best of a few sample points.
-  static const std::vector<Vec2> quad_starts = {Vec2(0, 0),    Vec2(-0.6, -0.6), Vec2(0, -0.6), Vec2(0.6, -0.6),
-                                                Vec2(-0.6, 0), Vec2(0.6, 0),     Vec2(-0.6, 0.6), Vec2(0, 0.6),
-                                                Vec2(0.6, 0.6)};
-  static const std::vector<Vec2> tri_starts = {Vec2(1.0 / 3, 1.0 / 3), Vec2(0.15, 0.15), Vec2(0.7, 0.15), Vec2(0.15, 0.7),
-                                               Vec2(0.45, 0.1),        Vec2(0.45, 0.45), Vec2(0.1, 0.45)};
+  static const std::vector<Vec2> quad_starts = {Vec2(0, 0),      Vec2(-0.6, -0.6), Vec2(0, -0.6),
+                                                Vec2(0.6, -0.6), Vec2(-0.6, 0),    Vec2(0.6, 0),
+                                                Vec2(-0.6, 0.6), Vec2(0, 0.6),     Vec2(0.6, 0.6)};
+  static const std::vector<Vec2> tri_starts = {Vec2(1.0 / 3, 1.0 / 3), Vec2(0.15, 0.15), Vec2(0.7, 0.15),
+                                               Vec2(0.15, 0.7),        Vec2(0.45, 0.1),  Vec2(0.45, 0.45),
+                                               Vec2(0.1, 0.45)};
   const auto& starts = k == FaceKind::Quad4 ? quad_starts : tri_starts;
   // Order the sample points by distance; run Newton from the best, and from the next ones if it fails.
   std::array<std::pair<double, int>, 9> order;
@@ -266,8 +271,7 @@ void linearize(FaceKind k, const FaceX& X, double normal_sign, const Vec3& x, co
     Eigen::MatrixXd B = Eigen::MatrixXd::Zero(2, m);
     for (int be = 0; be < 2; ++be) {
       B.block<1, 3>(be, 0) = a[be].transpose();
-      for (int b = 0; b < nn; ++b)
-        B.block<1, 3>(be, 3 + 3 * b) = -N(b) * a[be].transpose() + dN(b, be) * r.transpose();
+      for (int b = 0; b < nn; ++b) B.block<1, 3>(be, 3 + 3 * b) = -N(b) * a[be].transpose() + dN(b, be) * r.transpose();
     }
     out.dxi = A.inverse() * B;
     Eigen::Matrix<double, 3, 2> acov;

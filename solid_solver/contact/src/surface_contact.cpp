@@ -61,8 +61,7 @@ double surface_gp_kernel(FaceKind sk, const FaceX& Xs, const Vec2& xi_g, double 
   d2W.topLeftCorner(ms, ms) = Dn.transpose() * T * Dn / j;
   const Mat3 S = skew(nu);
   for (int a = 0; a < ns; ++a)
-    for (int b = 0; b < ns; ++b)
-      d2W.block<3, 3>(3 * a, 3 * b) += (dNs(a, 1) * dNs(b, 0) - dNs(a, 0) * dNs(b, 1)) * S;
+    for (int b = 0; b < ns; ++b) d2W.block<3, 3>(3 * a, 3 * b) += (dNs(a, 1) * dNs(b, 0) - dNs(a, 0) * dNs(b, 1)) * S;
   d2W *= w_g;
 
   // K = pi d2W + pi' (dW^T dg + dg^T dW) + W (pi'' dg^T dg + pi' d2g)

@@ -52,8 +52,12 @@ def classify_surface(tag):
     umin, umax = gmsh.model.getParametrizationBounds(2, tag)
     x, y, z = gmsh.model.getValue(2, tag, [0.5 * (umin[0] + umax[0]), 0.5 * (umin[1] + umax[1])])
     r = math.hypot(x, y)
-    for name, hit in [("end0", abs(z) < 1e-9), ("end1", abs(z - LENGTH) < 1e-9),
-                      ("inner", abs(r - RADII[0]) < 1e-9), ("outer", abs(r - RADII[-1]) < 1e-9)]:
+    for name, hit in [
+        ("end0", abs(z) < 1e-9),
+        ("end1", abs(z - LENGTH) < 1e-9),
+        ("inner", abs(r - RADII[0]) < 1e-9),
+        ("outer", abs(r - RADII[-1]) < 1e-9),
+    ]:
         if hit:
             return name
     return None

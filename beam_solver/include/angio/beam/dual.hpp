@@ -12,14 +12,16 @@ template <class T, int N>
 struct Dual {
   T v;
   std::array<T, N> d;
-  Dual() = default;  // uninitialized (performance); use Dual(0.0) for a zero
-  Dual(double c) : v(c) { d.fill(T(0.0)); }  // NOLINT: implicit constant
+  Dual() = default;                                  // uninitialized (performance); use Dual(0.0) for a zero
+  Dual(double c) : v(c) { d.fill(T(0.0)); }          // NOLINT: implicit constant
   explicit Dual(const T& value, bool) : v(value) {}  // derivatives set by the caller
 };
 
 inline double val(double x) { return x; }
 template <class T, int N>
-double val(const Dual<T, N>& a) { return val(a.v); }
+double val(const Dual<T, N>& a) {
+  return val(a.v);
+}
 
 template <class T, int N>
 Dual<T, N> operator+(const Dual<T, N>& a, const Dual<T, N>& b) {
@@ -52,7 +54,9 @@ Dual<T, N> operator*(const Dual<T, N>& a, double s) {
   return r;
 }
 template <class T, int N>
-Dual<T, N> operator*(double s, const Dual<T, N>& a) { return a * s; }
+Dual<T, N> operator*(double s, const Dual<T, N>& a) {
+  return a * s;
+}
 template <class T, int N>
 Dual<T, N> operator+(const Dual<T, N>& a, double s) {
   Dual<T, N> r = a;
@@ -60,11 +64,17 @@ Dual<T, N> operator+(const Dual<T, N>& a, double s) {
   return r;
 }
 template <class T, int N>
-Dual<T, N> operator+(double s, const Dual<T, N>& a) { return a + s; }
+Dual<T, N> operator+(double s, const Dual<T, N>& a) {
+  return a + s;
+}
 template <class T, int N>
-Dual<T, N> operator-(const Dual<T, N>& a, double s) { return a + (-s); }
+Dual<T, N> operator-(const Dual<T, N>& a, double s) {
+  return a + (-s);
+}
 template <class T, int N>
-Dual<T, N> operator-(double s, const Dual<T, N>& a) { return (-a) + s; }
+Dual<T, N> operator-(double s, const Dual<T, N>& a) {
+  return (-a) + s;
+}
 template <class T, int N>
 Dual<T, N> inv(const Dual<T, N>& a) {
   T iv = T(1.0) / a.v;
@@ -74,11 +84,17 @@ Dual<T, N> inv(const Dual<T, N>& a) {
   return r;
 }
 template <class T, int N>
-Dual<T, N> operator/(const Dual<T, N>& a, const Dual<T, N>& b) { return a * inv(b); }
+Dual<T, N> operator/(const Dual<T, N>& a, const Dual<T, N>& b) {
+  return a * inv(b);
+}
 template <class T, int N>
-Dual<T, N> operator/(const Dual<T, N>& a, double s) { return a * (1.0 / s); }
+Dual<T, N> operator/(const Dual<T, N>& a, double s) {
+  return a * (1.0 / s);
+}
 template <class T, int N>
-Dual<T, N> operator/(double s, const Dual<T, N>& a) { return inv(a) * s; }
+Dual<T, N> operator/(double s, const Dual<T, N>& a) {
+  return inv(a) * s;
+}
 
 template <class T, int N>
 Dual<T, N> sqrt(const Dual<T, N>& a) {

@@ -32,14 +32,12 @@ struct ElementReference {
 };
 
 // Builds the reference data; O1, O2 are the element's reference triads at its two nodes.
-ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Quat& O1,
-                                         const Quat& O2);
+ElementReference make_element_reference(const Vec3& X1, const Vec3& X2, const Quat& O1, const Quat& O2);
 // Triad with e1 along (X2 − X1) and e2 as close as possible to `up`.
 Quat triad_from_tangent(const Vec3& t, const Vec3& up);
 
 // Convected strains (Γ, Ω) of the current configuration.
-Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1,
-                    const Quat& R2);
+Vec6 element_strain(const ElementReference& ref, const Vec3& x1, const Vec3& x2, const Quat& R1, const Quat& R2);
 
 struct ElementResult {
   Vec12 residual;  // internal forces and moments (spatial), N and N mm
@@ -63,13 +61,12 @@ struct ElementResult {
 //                   d×n term and O(φ²) in the moment term (φ: relative rotation of the element).
 enum class ResidualForm { consistent, petrov_galerkin };
 
-ElementResult evaluate_element(const Section& s, const ElementReference& ref, const Vec3& x1,
-                               const Vec3& x2, const Quat& R1, const Quat& R2,
-                               const PlasticState& committed, bool with_tangent = true,
+ElementResult evaluate_element(const Section& s, const ElementReference& ref, const Vec3& x1, const Vec3& x2,
+                               const Quat& R1, const Quat& R2, const PlasticState& committed, bool with_tangent = true,
                                ResidualForm form = ResidualForm::consistent);
 
 // Rotation helpers.
-Quat quat_exp(const Vec3& theta);   // exp of a rotation vector
-Vec3 quat_log(const Quat& q);       // rotation vector (|θ| <= π)
+Quat quat_exp(const Vec3& theta);  // exp of a rotation vector
+Vec3 quat_log(const Quat& q);      // rotation vector (|θ| <= π)
 
 }  // namespace angio::beam

@@ -25,8 +25,7 @@ struct Section {
 // Circular section of radius R (shear factor 6(1+nu)/(7+6nu) by default, Cowper).
 Section circular_section(double E, double nu, double R, double shear_factor = -1.0);
 // General section from A, I2, I3, J and shear factors.
-Section general_section(double E, double G, double A, double I2, double I3, double J,
-                        double k2, double k3);
+Section general_section(double E, double G, double A, double I2, double I3, double J, double k2, double k3);
 // Adds Appendix C plasticity: M_y = My0 + H I κ̄, H = Eep / (1 - Eep/E), I = EI/E.
 void add_bending_plasticity(Section& s, double E, double My0, double Eep);
 
@@ -37,8 +36,8 @@ struct PlasticState {
 };
 
 struct SectionResponse {
-  Vec6 stress;      // (F, M) convected
-  Mat6 tangent;     // d(stress)/d(strain), algorithmic
+  Vec6 stress;         // (F, M) convected
+  Mat6 tangent;        // d(stress)/d(strain), algorithmic
   PlasticState state;  // updated internal variables
   bool yielding = false;
   double bending_moment_norm = 0.0;

@@ -37,7 +37,7 @@ struct NodalLoad {
   Vec3 moment = Vec3::Zero();  // N mm, fixed in space
   Curve curve = constant_curve();
 };
-struct LineLoad {  // uniform distributed force per reference length (N/mm), fixed in space
+struct LineLoad {             // uniform distributed force per reference length (N/mm), fixed in space
   std::vector<int> elements;  // empty: all
   Vec3 q = Vec3::Zero();
   Curve curve = constant_curve();
@@ -210,9 +210,9 @@ class BeamModel {
   int planes_per_point_ = 0;
   std::vector<Vec3> ref_radial_;  // reference radial direction per sample point
   std::vector<char> identity_basis_;
-  std::vector<int> elem_dofs_;    // per element its 12 free DOF indices (−1: fixed)
-  SpMat pattern_;                 // sparsity pattern of the reduced tangent (built once)
-  std::vector<int> elem_pos_;     // per element 144 positions into pattern_ values (−1: fixed)
+  std::vector<int> elem_dofs_;  // per element its 12 free DOF indices (−1: fixed)
+  SpMat pattern_;               // sparsity pattern of the reduced tangent (built once)
+  std::vector<int> elem_pos_;   // per element 144 positions into pattern_ values (−1: fixed)
   // assembly scratch, reused between calls: element results and per-element distributed loads
   std::vector<ElementResult> elem_results_;
   std::vector<Vec3> elem_q_;                           // uniform line load (N/mm)

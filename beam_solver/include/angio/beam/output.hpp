@@ -58,9 +58,8 @@ struct StepRecord {
 // Writes summary.json (nlohmann::json, indent 2; non-finite numbers as null); returns the text
 // written. `initial`: the measures of the reference state (its diameter for every model, the
 // stent measures for generated stents).
-std::string write_summary(const std::string& path, const BeamModel& m,
-                          const std::vector<StepRecord>& steps, bool generated_stent,
-                          const std::string& status, double newton_seconds, long newton_iterations,
-                          const StepRecord& initial);
+std::string write_summary(const std::string& path, const BeamModel& m, const std::vector<StepRecord>& steps,
+                          bool generated_stent, const std::string& status, double newton_seconds,
+                          long newton_iterations, const StepRecord& initial);
 
 }  // namespace angio::beam

@@ -17,8 +17,7 @@ namespace angio::beam {
 
 // Polyline through the centroids of the rings' crowns (`ring_crowns[k]`: node indices of ring k,
 // in order along the device) at positions `x`; nullopt for fewer than two rings.
-std::optional<Axis> ring_centroid_axis(const std::vector<std::vector<int>>& ring_crowns,
-                                       const std::vector<Vec3>& x);
+std::optional<Axis> ring_centroid_axis(const std::vector<std::vector<int>>& ring_crowns, const std::vector<Vec3>& x);
 
 // 2 × mean distance of the nodes `nodes` (all nodes when empty) from `axis`.
 double mean_diameter(const Axis& axis, const std::vector<Vec3>& x, const std::vector<int>& nodes = {});

@@ -46,23 +46,22 @@ struct StentParameters {
 struct StentMesh {
   std::vector<Vec3> nodes;
   std::vector<std::array<int, 2>> elements;
-  std::vector<Vec3> element_up;   // reference e2 direction (outward radial) per element
-  std::vector<int> element_kind;  // 0 strut, 1 connector
-  std::vector<int> element_group; // strut or connector index (elements of one strut share it)
-  std::vector<int> fixation_nodes;       // 4 bottom crowns of the middle ring, 90° apart
-  std::vector<int> ring_fixation_nodes;  // 4 bottom crowns of every ring, 90° apart
-  std::vector<int> distal_nodes;   // outer crowns of the end rings (dogboning)
-  std::vector<int> central_nodes;  // crowns of the middle ring(s)
+  std::vector<Vec3> element_up;               // reference e2 direction (outward radial) per element
+  std::vector<int> element_kind;              // 0 strut, 1 connector
+  std::vector<int> element_group;             // strut or connector index (elements of one strut share it)
+  std::vector<int> fixation_nodes;            // 4 bottom crowns of the middle ring, 90° apart
+  std::vector<int> ring_fixation_nodes;       // 4 bottom crowns of every ring, 90° apart
+  std::vector<int> distal_nodes;              // outer crowns of the end rings (dogboning)
+  std::vector<int> central_nodes;             // crowns of the middle ring(s)
   std::vector<std::vector<int>> ring_crowns;  // crowns of each ring, rings in order (ring_axis.hpp)
-  std::vector<Vec3> axis;         // device axis polyline
+  std::vector<Vec3> axis;                     // device axis polyline
   int num_struts = 0, num_connectors = 0;
 };
 
 // Straight stent along +z from z = 0 (centerline empty), or warped onto the centerline
 // starting at arc length p.start (−1: centred). Throws std::invalid_argument on bad parameters,
 // a centerline shorter than the stent, or a degenerate centerline.
-StentMesh generate_corrugated_rings(const StentParameters& p,
-                                    const std::vector<Vec3>& centerline = {});
+StentMesh generate_corrugated_rings(const StentParameters& p, const std::vector<Vec3>& centerline = {});
 StentMesh generate_corrugated_rings(const StentParameters& p, const geometry::Centerline& centerline);
 
 }  // namespace angio::beam

@@ -19,8 +19,8 @@ class Aitken : public Acceleration {
 
  private:
   double initial_, maximum_;
-  double omega_;        // factor of the current iteration
-  double omega_prev_;   // last factor of the previous accepted step
+  double omega_;             // factor of the current iteration
+  double omega_prev_;        // last factor of the previous accepted step
   double omega_step_start_;  // ω_prev when the current step began (restored on rejection)
   Eigen::VectorXd r_prev_;
 };
@@ -30,9 +30,7 @@ class ConstantRelaxation : public Acceleration {
  public:
   explicit ConstantRelaxation(double omega) : omega_(omega) {}
   void begin_step() override {}
-  Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int) override {
-    return q + omega_ * r;
-  }
+  Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int) override { return q + omega_ * r; }
   void end_step(bool) override {}
   double last_factor() const override { return omega_; }
   std::string name() const override { return "constant"; }

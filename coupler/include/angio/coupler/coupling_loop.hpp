@@ -19,15 +19,15 @@ namespace angio::coupler {
 struct StepReport {
   int step = 0;
   double time = 0.0;
-  int iterations = 0;              // coupling iterations of the accepted attempt
-  std::vector<double> residuals;   // ||r_k|| per iteration of that attempt
-  double omega = 0.0;              // last relaxation factor
-  int cuts = 0;                    // rejected attempts before acceptance
-  int restarts = 0;                // acceleration restarts in the accepted attempt (restart_growth)
-  bool converged = true;           // false: accepted with a warning (strict: false)
-  double beam_time = 0.0;          // s in beam solves (incl. messaging when remote)
-  double solid_time = 0.0;         // s in solid solves (incl. messaging when remote)
-  double wall_time = 0.0;          // s for the whole step incl. rejected attempts
+  int iterations = 0;             // coupling iterations of the accepted attempt
+  std::vector<double> residuals;  // ||r_k|| per iteration of that attempt
+  double omega = 0.0;             // last relaxation factor
+  int cuts = 0;                   // rejected attempts before acceptance
+  int restarts = 0;               // acceleration restarts in the accepted attempt (restart_growth)
+  bool converged = true;          // false: accepted with a warning (strict: false)
+  double beam_time = 0.0;         // s in beam solves (incl. messaging when remote)
+  double solid_time = 0.0;        // s in solid solves (incl. messaging when remote)
+  double wall_time = 0.0;         // s for the whole step incl. rejected attempts
   participant::ContactReply contact;
   participant::SamplePoints beam_points;
 };
@@ -57,7 +57,7 @@ using StepCallback = std::function<void(const StepReport&)>;
 // completed even at the minimum increment; participants have rolled back to their last committed
 // state by then, so everything written so far stays consistent.
 RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
-                      const scene::TimeSettings& time, const CouplingSettings& settings,
-                      Acceleration& acceleration, const StepCallback& on_step = {});
+                      const scene::TimeSettings& time, const CouplingSettings& settings, Acceleration& acceleration,
+                      const StepCallback& on_step = {});
 
 }  // namespace angio::coupler

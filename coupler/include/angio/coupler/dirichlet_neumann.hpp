@@ -11,8 +11,7 @@ class DirichletNeumann : public InterfaceScheme {
   explicit DirichletNeumann(std::size_t n_points);
   void begin_step(double increment, bool extrapolate) override;
   participant::SolveStats solve_beam(participant::BeamParticipant& beam) override;
-  Eigen::VectorXd force_residual(const participant::SamplePoints& x,
-                                 const participant::ContactReply& reply) override;
+  Eigen::VectorXd force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) override;
   void next_iterate(Acceleration& acc, int k) override;
   void accept(double increment) override;
 

@@ -20,8 +20,7 @@ class Robin : public InterfaceScheme {
   explicit Robin(std::size_t n_points);
   void begin_step(double increment, bool extrapolate) override;
   participant::SolveStats solve_beam(participant::BeamParticipant& beam) override;
-  Eigen::VectorXd force_residual(const participant::SamplePoints& x,
-                                 const participant::ContactReply& reply) override;
+  Eigen::VectorXd force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) override;
   void next_iterate(Acceleration& acc, int k) override;
   void accept(double increment) override;
 

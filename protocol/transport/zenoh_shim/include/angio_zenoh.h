@@ -32,13 +32,13 @@ extern "C" {
 #endif
 
 #define AZ_OK 0
-#define AZ_TIMEOUT 1              /* nothing arrived within the timeout */
-#define AZ_NO_REPLY 2             /* request finished without reply (no matching queryable) */
-#define AZ_ERR (-1)               /* generic failure, see az_last_error() */
+#define AZ_TIMEOUT 1  /* nothing arrived within the timeout */
+#define AZ_NO_REPLY 2 /* request finished without reply (no matching queryable) */
+#define AZ_ERR (-1)   /* generic failure, see az_last_error() */
 #define AZ_ERR_INVALID_ARGUMENT (-2)
-#define AZ_ERR_DISCONNECTED (-3)  /* the entity's channel is closed (session closed) */
-#define AZ_ERR_REPLY (-4)         /* the replier answered with an error; message in az_last_error() */
-#define AZ_ERR_PANIC (-5)         /* internal bug caught at the FFI boundary */
+#define AZ_ERR_DISCONNECTED (-3) /* the entity's channel is closed (session closed) */
+#define AZ_ERR_REPLY (-4)        /* the replier answered with an error; message in az_last_error() */
+#define AZ_ERR_PANIC (-5)        /* internal bug caught at the FFI boundary */
 
 typedef struct az_session az_session;
 typedef struct az_queryable az_queryable;
@@ -71,8 +71,8 @@ int az_init_log(const char* fallback_filter);
  * in the background (100 ms .. 1 s period), so opening succeeds before the remote listens;
  * with connect endpoints, opening waits up to 0.5 s (zenoh's scouting delay) for the first
  * connection and its declarations, so a peer that is already up is usable right away. */
-int az_session_open(const char* const* listen, size_t n_listen, const char* const* connect,
-                    size_t n_connect, az_session** out);
+int az_session_open(const char* const* listen, size_t n_listen, const char* const* connect, size_t n_connect,
+                    az_session** out);
 
 /* Closes the session and frees the handle. */
 int az_session_close(az_session* s);
@@ -87,8 +87,7 @@ void az_queryable_drop(az_queryable* q);
 
 /* AZ_OK: *out_query is a new handle and *out_payload the request payload.
  * AZ_TIMEOUT: nothing within timeout_ms. AZ_ERR_DISCONNECTED: session closed. */
-int az_queryable_recv(const az_queryable* q, uint64_t timeout_ms, az_query** out_query,
-                      az_bytes* out_payload);
+int az_queryable_recv(const az_queryable* q, uint64_t timeout_ms, az_query** out_query, az_bytes* out_payload);
 
 /* Key expression the query was sent to; valid while the query handle lives. */
 const char* az_query_keyexpr(const az_query* q);
@@ -113,8 +112,8 @@ typedef int (*az_accept_fn)(void* ctx, const uint8_t* data, size_t len);
  * AZ_NO_REPLY: finished without reply, usually because no matching queryable is reachable
  * (returned immediately in that case; callers that wait for a peer retry).
  * AZ_ERR_REPLY: the replier sent an error reply (its message is in az_last_error()). */
-int az_request(const az_session* s, const char* keyexpr, const uint8_t* data, size_t len,
-               uint64_t timeout_ms, az_accept_fn accept, void* accept_ctx, az_bytes* out_reply);
+int az_request(const az_session* s, const char* keyexpr, const uint8_t* data, size_t len, uint64_t timeout_ms,
+               az_accept_fn accept, void* accept_ctx, az_bytes* out_reply);
 
 /* --- publish / subscribe ------------------------------------------------------------------ */
 
@@ -125,8 +124,7 @@ void az_publisher_drop(az_publisher* p);
 int az_subscriber_declare(const az_session* s, const char* keyexpr, az_subscriber** out);
 /* AZ_OK: *out_payload and (if out_key != NULL) *out_key (sample key, not NUL-terminated)
  * are filled. AZ_TIMEOUT: nothing within timeout_ms. */
-int az_subscriber_recv(const az_subscriber* sub, uint64_t timeout_ms, az_bytes* out_payload,
-                       az_bytes* out_key);
+int az_subscriber_recv(const az_subscriber* sub, uint64_t timeout_ms, az_bytes* out_payload, az_bytes* out_key);
 void az_subscriber_drop(az_subscriber* sub);
 
 /* --- liveliness --------------------------------------------------------------------------- */
@@ -137,16 +135,15 @@ int az_liveliness_token_declare(const az_session* s, const char* keyexpr, az_tok
 void az_liveliness_token_drop(az_token* t);
 
 /* Number of alive tokens matching keyexpr, asking the network for at most timeout_ms. */
-int az_liveliness_count(const az_session* s, const char* keyexpr, uint64_t timeout_ms,
-                        size_t* out_count);
+int az_liveliness_count(const az_session* s, const char* keyexpr, uint64_t timeout_ms, size_t* out_count);
 
 /* Change notifications for tokens matching keyexpr; history != 0 also reports tokens that are
  * already alive. recv: AZ_OK with *out_alive = 1 (appeared) or 0 (disappeared) and the token
  * key in *out_key (if not NULL); AZ_TIMEOUT if no change within timeout_ms. */
 int az_liveliness_subscriber_declare(const az_session* s, const char* keyexpr, int history,
                                      az_liveliness_subscriber** out);
-int az_liveliness_subscriber_recv(const az_liveliness_subscriber* sub, uint64_t timeout_ms,
-                                  int* out_alive, az_bytes* out_key);
+int az_liveliness_subscriber_recv(const az_liveliness_subscriber* sub, uint64_t timeout_ms, int* out_alive,
+                                  az_bytes* out_key);
 void az_liveliness_subscriber_drop(az_liveliness_subscriber* sub);
 
 #ifdef __cplusplus

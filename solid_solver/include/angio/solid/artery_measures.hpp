@@ -41,7 +41,7 @@ struct Apposition {
   double malapposed_length = 0.0;    // Σ w over points with g > threshold (or no wall in range)
   double malapposed_fraction = 0.0;  // malapposed_length / length
   double max_gap = -std::numeric_limits<double>::infinity();  // largest finite gap (mm)
-  double mean_gap = 0.0;             // length-weighted mean of the finite gaps (mm)
+  double mean_gap = 0.0;                                      // length-weighted mean of the finite gaps (mm)
 };
 Apposition apposition(const std::vector<double>& gap, const std::vector<double>& weight, double threshold);
 

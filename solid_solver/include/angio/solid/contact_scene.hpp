@@ -41,7 +41,7 @@ struct ContactSpec {
   };
   std::optional<Insertion> insertion;
   double search_radius = 0.3;
-  double line_regularization = 0.0;  // g0, mm (line_contact.hpp LineContactParams::regularization)
+  double line_regularization = 0.0;    // g0, mm (line_contact.hpp LineContactParams::regularization)
   bool line_averaged_normals = false;  // LineContactParams::averaged_normals
   bool log = true;
 };

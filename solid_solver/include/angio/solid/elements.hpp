@@ -19,15 +19,19 @@ enum class FaceType { Quad4, Tri3, Tri6 };
 // The same face as a contact face kind (the face shape functions live in angio::contact).
 inline contact::FaceKind to_contact(FaceType t) {
   static_assert(int(FaceType::Quad4) == int(contact::FaceKind::Quad4) &&
-                int(FaceType::Tri3) == int(contact::FaceKind::Tri3) && int(FaceType::Tri6) == int(contact::FaceKind::Tri6));
+                int(FaceType::Tri3) == int(contact::FaceKind::Tri3) &&
+                int(FaceType::Tri6) == int(contact::FaceKind::Tri6));
   return contact::FaceKind(int(t));
 }
 
 constexpr int num_nodes(ElemType t) {
   switch (t) {
-    case ElemType::Hex8: return 8;
-    case ElemType::Tet4: return 4;
-    case ElemType::Tet10: return 10;
+    case ElemType::Hex8:
+      return 8;
+    case ElemType::Tet4:
+      return 4;
+    case ElemType::Tet10:
+      return 10;
   }
   return 0;
 }

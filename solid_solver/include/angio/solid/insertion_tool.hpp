@@ -41,8 +41,8 @@ class InsertionTool : public ContactModel {
 
  private:
   Options opt_;
-  std::vector<int> nodes_;     // surface nodes owned by this rank (original numbering)
-  std::vector<double> area_;   // their lumped reference areas (mm^2)
+  std::vector<int> nodes_;    // surface nodes owned by this rank (original numbering)
+  std::vector<double> area_;  // their lumped reference areas (mm^2)
   ContactSummary last_;
 };
 

@@ -96,8 +96,7 @@ std::vector<FiberFamily> resolve_fibers(const LayerMaterial& m, const Frame& fra
 
 // Total energy, stress and tangent of a layer material at a material point with resolved fibers.
 double energy(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C);
-void stress_tangent(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C, Mat3& S,
-                    Mat6* D);
+void stress_tangent(const NeoHooke& m, const std::vector<FiberFamily>& fibers, const Mat3& C, Mat3& S, Mat6* D);
 
 // First principal Cauchy stress and its direction from F and S (sigma = F S F^T / J).
 void first_principal_cauchy(const Mat3& F, const Mat3& S, double& s1, Vec3d& dir);

@@ -14,8 +14,8 @@ namespace angio::solid {
 
 struct Element {
   ElemType type = ElemType::Hex8;
-  int block = 0;              // index into Mesh::blocks
-  std::array<int, 10> n{};    // node indices (first num_nodes(type) used)
+  int block = 0;            // index into Mesh::blocks
+  std::array<int, 10> n{};  // node indices (first num_nodes(type) used)
   int nn() const { return num_nodes(type); }
 };
 
@@ -26,12 +26,12 @@ struct Face {
 };
 
 struct Block {
-  std::string name;   // e.g. "balloon", "media", "adventitia"
-  std::string part;   // "balloon" or "artery" (used for summaries)
+  std::string name;  // e.g. "balloon", "media", "adventitia"
+  std::string part;  // "balloon" or "artery" (used for summaries)
 };
 
 struct SurfaceSet {
-  std::string name;   // e.g. "balloon_inner", "artery_endo", "artery_end0"
+  std::string name;  // e.g. "balloon_inner", "artery_endo", "artery_end0"
   std::vector<Face> faces;
 };
 
@@ -50,7 +50,7 @@ struct Mesh {
   // Optional local material frame per element (fiber directions); empty: built from the model's axis.
   std::vector<Frame> frames;
 
-  int block_index(const std::string& name) const;     // -1 if absent
+  int block_index(const std::string& name) const;  // -1 if absent
   const SurfaceSet* surface(const std::string& name) const;
   // Append another mesh (node/element indices shifted, names kept).
   void append(const Mesh& other);
@@ -95,7 +95,7 @@ struct TubeSpec {
   int n_axial = 8;
   Vec3d center = Vec3d::Zero();
   std::optional<geometry::Centerline> centerline;  // curved axis (none: straight along +z)
-  double start = 0.0;  // mm, arc length of end0 on the centerline
+  double start = 0.0;                              // mm, arc length of end0 on the centerline
   TubeStenosis stenosis;
 };
 // Throws std::runtime_error on bad parameters or a tube that does not fit on the centerline.
@@ -109,8 +109,7 @@ Mesh make_tube(const TubeSpec& spec);
 // Coordinates are multiplied by `scale`. Every count is checked against the bytes left in the file
 // before anything is allocated. Throws std::runtime_error("file:line: ..." for ASCII,
 // "file: ... at byte offset N" for binary files) on bad input.
-Mesh read_gmsh(const std::string& path, const std::string& part, const std::string& surface_prefix,
-               double scale = 1.0);
+Mesh read_gmsh(const std::string& path, const std::string& part, const std::string& surface_prefix, double scale = 1.0);
 
 // Local frame of an element from a straight axis (element centroid, reference geometry).
 Frame element_frame(const Mesh& m, int e, const Axis& axis);

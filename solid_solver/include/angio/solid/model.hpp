@@ -34,11 +34,11 @@ class ContactModel {
 
 struct NewtonOptions {
   int max_iterations = 30;
-  double rtol = 1e-8;        // ||r|| <= rtol * ||r_0|| (r_0: first residual of the solve)
-  double atol = 1e-9;        // or ||r|| <= atol (N)
-  bool line_search = true;   // backtracking on ||r|| (halving, up to max_line_search times)
+  double rtol = 1e-8;       // ||r|| <= rtol * ||r_0|| (r_0: first residual of the solve)
+  double atol = 1e-9;       // or ||r|| <= atol (N)
+  bool line_search = true;  // backtracking on ||r|| (halving, up to max_line_search times)
   int max_line_search = 6;
-  bool verbose = false;      // per-iteration log on rank 0
+  bool verbose = false;  // per-iteration log on rank 0
   // Artificial viscous damping over the pseudo-time (as Abaqus' *STATIC, STABILIZE): each node gets
   // the force η·V_a·(u_a − u_a,committed)/Δt, V_a its share of the element volumes, Δt the time since
   // the last commit; η in N·s/mm⁴. It carries a load step over a limit point or bifurcation of the
@@ -93,7 +93,7 @@ struct ModelOptions {
   std::string partitioner = "contiguous";  // "contiguous" or a MatPartitioning type (ptscotch, parmetis, average...)
   std::string petsc_options;               // appended after the defaults (GMRES(200) + block-Jacobi ILU(1))
   NewtonOptions newton;
-  Axis axis;                               // fiber frames if the mesh has none
+  Axis axis;  // fiber frames if the mesh has none
 };
 
 struct SolveReport {
@@ -103,8 +103,8 @@ struct SolveReport {
   std::vector<double> residual_history;
   std::string message;
   int linear_iterations = 0;
-  int factorizations = 0;     // preconditioner setups (LU factorizations with -pc_type lu)
-  int tangent_assemblies = 0; // assemblies with the tangent (the others: residual only, modified Newton)
+  int factorizations = 0;         // preconditioner setups (LU factorizations with -pc_type lu)
+  int tangent_assemblies = 0;     // assemblies with the tangent (the others: residual only, modified Newton)
   double assembly_seconds = 0.0;  // elements, loads and contact
   double contact_seconds = 0.0;   // of which contact
   double linear_seconds = 0.0;
@@ -259,10 +259,10 @@ class SolidModel {
   double time_ = 0.0, committed_time_ = 0.0;
   bool apply_bc_ = true;
   std::vector<double> u_, u_committed_;  // full copies, new numbering
-  std::vector<double> u_before_;          // the commit before u_committed_ (newton.extrapolate)
+  std::vector<double> u_before_;         // the commit before u_committed_ (newton.extrapolate)
   double before_time_ = 0.0;
-  Vec damping_diag_ = nullptr;            // η·V_a per owned dof (NewtonOptions::damping); null when off
-  Vec damping_tangent_ = nullptr;         // η·V_a/Δt, refilled per assembly (no allocation in Newton)
+  Vec damping_diag_ = nullptr;     // η·V_a per owned dof (NewtonOptions::damping); null when off
+  Vec damping_tangent_ = nullptr;  // η·V_a/Δt, refilled per assembly (no allocation in Newton)
   double damping_(Vec r, Mat K);
   // Viscous branch (eqs. B.5–B.8): committed history per Gauss point of the local elements whose
   // material has one; visc_offset_[i] indexes local element i's first Gauss point (−1: none).
@@ -275,7 +275,7 @@ class SolidModel {
   void element_state_(int e, Eigen::MatrixXd& X, Eigen::MatrixXd& u) const;
   bool pc_current_ = false;  // the preconditioner holds a setup that may be reused (reuse_preconditioner, modified)
   double contact_seconds_ = 0.0;  // time in contact_->add() over the model's life (SolveReport::contact_seconds)
-  int invalid_element_ = -1;           // invalid_element()
+  int invalid_element_ = -1;      // invalid_element()
   Vec3d invalid_at_ = Vec3d::Zero();
   Mat K_ = nullptr;
   Vec r_ = nullptr, du_ = nullptr;

@@ -44,12 +44,12 @@ void reset_reply(const participant::SamplePoints& points, participant::ContactRe
 // the Gauss-point averaged Cauchy tensor).
 // (The maximum itself is StepSummary::max_p1, known on every rank.)
 struct BlockStress {
-  Vec3d where = Vec3d::Zero();   // current centroid of the element with the maximum
-  double p99 = 0.0;              // 99th percentile by reference volume (MPa), robust against one element at a strut
+  Vec3d where = Vec3d::Zero();  // current centroid of the element with the maximum
+  double p99 = 0.0;             // 99th percentile by reference volume (MPa), robust against one element at a strut
   // The recovered nodal first principal stress of the block (stress_recovery.hpp: L2 projection onto
   // the block's own nodes, a layer interface node has one value per layer), rank 0 only; NaN: none.
   double max_nodal = std::numeric_limits<double>::quiet_NaN();  // max over the block's nodes (MPa)
-  Vec3d where_nodal = Vec3d::Zero();                              // current position of that node
+  Vec3d where_nodal = Vec3d::Zero();                            // current position of that node
   // 99th percentile, each node weighted by its share of the block's reference volume (Σ V_e / n_e)
   double p99_nodal = std::numeric_limits<double>::quiet_NaN();
   // max over the block's nodes on the lumen surface (scene lumen set, the endothelium); NaN if the
@@ -61,15 +61,16 @@ struct BlockStress {
 struct StepSummary {
   int step = 0;
   double time = 0.0;
-  std::vector<std::pair<std::string, double>> pressures;  // label, MPa
-  std::vector<double> max_p1;                              // per block (MPa)
-  std::vector<BlockStress> stress;                         // per block
+  std::vector<std::pair<std::string, double>> pressures;         // label, MPa
+  std::vector<double> max_p1;                                    // per block (MPa)
+  std::vector<BlockStress> stress;                               // per block
   std::vector<std::pair<std::string, double>> max_displacement;  // per part (mm)
-  std::vector<double> lumen_diameter;                      // per lumen station (mm)
-  std::vector<std::pair<std::string, double>> artery_contact_force;  // per contact: Σ |nodal force| on the endothelium (N)
-  std::optional<Apposition> apposition;                    // stent vs endothelium
-  std::optional<std::pair<double, double>> stent_stations; // axial extent of the stent on the lumen stations (mm)
-  double d_mid = 0.0, d_end0 = 0.0, d_end1 = 0.0;          // balloon outer diameter (mm)
+  std::vector<double> lumen_diameter;                            // per lumen station (mm)
+  std::vector<std::pair<std::string, double>>
+      artery_contact_force;                                 // per contact: Σ |nodal force| on the endothelium (N)
+  std::optional<Apposition> apposition;                     // stent vs endothelium
+  std::optional<std::pair<double, double>> stent_stations;  // axial extent of the stent on the lumen stations (mm)
+  double d_mid = 0.0, d_end0 = 0.0, d_end1 = 0.0;           // balloon outer diameter (mm)
   int newton_iterations = 0;
   double residual = 0.0;
   double solve_seconds = 0.0;
@@ -82,8 +83,8 @@ class SolidRunner : public participant::SolidParticipant {
   ~SolidRunner() override;
 
   void begin_step(int step, double time) override;
-  participant::SolveStats solve(const participant::SamplePoints& beam_points,
-                                participant::ContactReply& reply, double tolerance) override;
+  participant::SolveStats solve(const participant::SamplePoints& beam_points, participant::ContactReply& reply,
+                                double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
 
@@ -116,9 +117,9 @@ class SolidRunner : public participant::SolidParticipant {
   std::string dir_;
   std::unique_ptr<SolidModel> model_;
   std::unique_ptr<FieldWriter> writer_;
-  std::unique_ptr<StressRecovery> recovery_;  // recovered nodal stresses per layer
+  std::unique_ptr<StressRecovery> recovery_;     // recovered nodal stresses per layer
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
-  double recovery_seconds_ = 0.0;              // all recover() calls (rank 0), summary.json timing
+  double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
@@ -139,8 +140,7 @@ class SolidRunner : public participant::SolidParticipant {
   // step: where a continuation starts from.
   double ok_time_ = 0.0, committed_ok_time_ = 0.0;
   std::vector<participant::Vec3> ok_x_, committed_ok_x_;
-  SolveReport continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start,
-                            double tolerance);
+  SolveReport continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start, double tolerance);
   void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
   void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
   void nodal_stress_(StepSummary& s) const;  // from recovery_, into s.stress (rank 0)
@@ -152,8 +152,8 @@ class MpiSolidParticipant : public participant::SolidParticipant {
  public:
   MpiSolidParticipant(participant::SolidParticipant& inner, MPI_Comm comm) : inner_(inner), comm_(comm) {}
   void begin_step(int step, double time) override;
-  participant::SolveStats solve(const participant::SamplePoints& beam_points,
-                                participant::ContactReply& reply, double tolerance) override;
+  participant::SolveStats solve(const participant::SamplePoints& beam_points, participant::ContactReply& reply,
+                                double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
   // Releases the followers if finish() was never called (e.g. the coupler vanished).

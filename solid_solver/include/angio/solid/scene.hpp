@@ -15,13 +15,13 @@ namespace angio::solid {
 
 struct PressureSpec {
   std::string surface;
-  double value = 0.0;       // MPa, multiplied by the curve
-  scene::LoadCurve curve;   // constant 1 when the scene gives none
-  std::string label;        // "balloon_pressure" / "blood_pressure"
+  double value = 0.0;      // MPa, multiplied by the curve
+  scene::LoadCurve curve;  // constant 1 when the scene gives none
+  std::string label;       // "balloon_pressure" / "blood_pressure"
 };
 struct SpringSpec {
   std::string surface;
-  double stiffness = 0.0;   // N/mm^3
+  double stiffness = 0.0;  // N/mm^3
 };
 // Balloon outer diameter stations for the summary (mid-length and both ends).
 // Zero displacement of the given components on the nodes of a surface set.
@@ -30,7 +30,7 @@ struct FixedSpec {
   std::vector<int> components;
 };
 struct DiameterSpec {
-  std::string node_set;     // outer surface nodes
+  std::string node_set;  // outer surface nodes
   Axis axis;
   // Curved balloon (mesh.centerline): stations are arc lengths along the centerline
   // (Centerline::closest), not coordinates along the straight `axis`. The diameter at a station is

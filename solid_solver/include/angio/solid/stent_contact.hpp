@@ -36,12 +36,12 @@ contact::Surface to_contact_surface(const SurfaceSet& s, double normal_sign = 1.
 
 // Summary of one contact evaluation (same on every rank after add()).
 struct ContactSummary {
-  int num_points = 0;     // (point or Gauss point, surface) pairs with a closest point in range
-  int num_active = 0;     // pairs with g < 0
-  double min_gap = 0.0;   // smallest gap (mm); +search radius if nothing was in range
-  double force = 0.0;     // |net force| on the solid (line contact: on balloon+artery; surface: on the master), N
+  int num_points = 0;    // (point or Gauss point, surface) pairs with a closest point in range
+  int num_active = 0;    // pairs with g < 0
+  double min_gap = 0.0;  // smallest gap (mm); +search radius if nothing was in range
+  double force = 0.0;    // |net force| on the solid (line contact: on balloon+artery; surface: on the master), N
   double force_magnitude = 0.0;  // sum over pairs of |force| (N)
-  double energy = 0.0;    // penalty potential (N mm)
+  double energy = 0.0;           // penalty potential (N mm)
 };
 
 // Wall time spent in add() (search update + evaluation + insertion into r/K), rank 0.
@@ -105,8 +105,8 @@ class PenaltyStentContact : public StentContact {
 class PenaltySurfaceContact : public ContactModel {
  public:
   struct Options {
-    double penalty = 5.0;      // N/mm^3 (pressure per penetration)
-    int quadrature = 3;        // slave face rule degree (3: quad 2x2)
+    double penalty = 5.0;         // N/mm^3 (pressure per penetration)
+    int quadrature = 3;           // slave face rule degree (3: quad 2x2)
     double regularization = 0.0;  // mm: C1 law active below this gap (contact::SurfaceContactParams)
     bool two_pass = false;
     double search_radius = 0.3;

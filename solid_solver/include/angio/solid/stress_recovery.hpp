@@ -46,31 +46,31 @@ class StressRecovery {
   int num_owned() const { return nloc_; }  // owned nodes; owned node i has the new index owned_node_begin() + i
   // Owned node i, block b (after recover()):
   bool has(int i, int b) const { return weight_[size_t(i) * nb_ + b] > 0.0; }  // the node belongs to block b
-  Mat3 stress(int i, int b) const;                                           // recovered Cauchy tensor (MPa)
-  double p1(int i, int b) const { return p1_[size_t(i) * nb_ + b]; }         // its first principal value; NaN if !has
+  Mat3 stress(int i, int b) const;                                             // recovered Cauchy tensor (MPa)
+  double p1(int i, int b) const { return p1_[size_t(i) * nb_ + b]; }           // its first principal value; NaN if !has
   // Share of the block's reference volume at the node: Σ over its elements of the block V_e / n_e
   // (positive; the weight of the nodal percentiles).
   double weight(int i, int b) const { return weight_[size_t(i) * nb_ + b]; }
   // p1 of block b for every owned node, NaN at nodes outside the block (the output field).
   std::vector<double> p1_field(int b) const;
 
-  double last_seconds() const { return seconds_; }   // wall time of the last recover() on this rank
+  double last_seconds() const { return seconds_; }     // wall time of the last recover() on this rank
   int last_iterations() const { return iterations_; }  // CG iterations of the last recover() (6 solves)
 
  private:
   const SolidModel& model_;
   Mass mass_;
   int nb_ = 0, nloc_ = 0;
-  std::vector<size_t> gauss_offset_;   // per local element: its first entry in the gauss vector
+  std::vector<size_t> gauss_offset_;  // per local element: its first entry in the gauss vector
   // The right-hand side is linear in the Gauss-point stresses and the mesh is the reference one: per
   // local element the constant matrix B_e (n × n_gauss, column-major) with b_e = B_e S_e, S_e the
   // element's Gauss-point stresses as Voigt rows, and the element's rows of the system; both computed
   // once in the constructor, so a step does no quadrature.
   std::vector<double> load_;
   std::vector<size_t> load_offset_;
-  std::vector<PetscInt> rows_;         // per local element its nn() rows, from rows_offset_
+  std::vector<PetscInt> rows_;  // per local element its nn() rows, from rows_offset_
   std::vector<size_t> rows_offset_;
-  std::vector<double> weight_, p1_;    // per owned (node, block)
+  std::vector<double> weight_, p1_;           // per owned (node, block)
   std::vector<std::array<double, 6>> sigma_;  // per owned (node, block), Voigt
   Mat M_ = nullptr;
   Vec lumped_ = nullptr;

@@ -19,8 +19,8 @@ class UsageError : public std::runtime_error {
 };
 
 struct Option {
-  std::string name;         // without leading dashes, e.g. "scene"
-  std::string value_name;   // e.g. "FILE"; empty for a flag without value
+  std::string name;        // without leading dashes, e.g. "scene"
+  std::string value_name;  // e.g. "FILE"; empty for a flag without value
   std::string help;
   std::string default_value;
 };

@@ -41,7 +41,8 @@ struct QuietErrors {
 };
 
 // A [rows, cols] dataset (cols = 1: one-dimensional).
-inline void write_dataset(hid_t loc, const std::string& name, hid_t type, hsize_t rows, hsize_t cols, const void* data) {
+inline void write_dataset(hid_t loc, const std::string& name, hid_t type, hsize_t rows, hsize_t cols,
+                          const void* data) {
   hsize_t dims[2] = {rows, cols};
   H5Id space(H5Screate_simple(cols > 1 ? 2 : 1, dims, nullptr), H5Sclose);
   H5Id ds(H5Dcreate2(loc, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
@@ -85,7 +86,8 @@ struct Reader {
     const int nd = H5Sget_simple_extent_ndims(space);
     if (nd < 1 || nd > 2) fail("dataset " + name + " is not a table");
     H5Sget_simple_extent_dims(space, dims, nullptr);
-    if (hsize_t(cols) != (nd == 2 ? dims[1] : 1)) fail("dataset " + name + ": expected " + std::to_string(cols) + " columns");
+    if (hsize_t(cols) != (nd == 2 ? dims[1] : 1))
+      fail("dataset " + name + ": expected " + std::to_string(cols) + " columns");
     rows = dims[0];
     std::vector<T> v(rows * cols);
     if (rows > 0 && H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) fail("cannot read " + name);

@@ -26,11 +26,11 @@ class LoadStepper {
   explicit LoadStepper(const scene::TimeSettings& settings);
 
   bool finished() const;
-  int step() const { return step_; }            // 1-based index of the step being attempted
-  double time() const { return t_ + dt_; }      // end time of the step being attempted
-  double previous_time() const { return t_; }   // last committed time
+  int step() const { return step_; }           // 1-based index of the step being attempted
+  double time() const { return t_ + dt_; }     // end time of the step being attempted
+  double previous_time() const { return t_; }  // last committed time
   double increment() const { return dt_; }
-  int cuts() const { return cuts_; }            // cuts of the current step so far
+  int cuts() const { return cuts_; }  // cuts of the current step so far
 
   // iterations: what the accepted step needed (coupling or Newton iterations; adaptive steps).
   void accept(int iterations);

@@ -24,13 +24,13 @@ std::string list(const std::vector<double>& values);
 }  // namespace angio::log
 
 // Streams only when the level is enabled: LOG_INFO("step " << n << " done");
-#define ANGIO_LOG(lvl, expr)                                   \
-  do {                                                         \
-    if (::angio::log::enabled(lvl)) {                          \
-      std::ostringstream angio_log_os_;                        \
-      angio_log_os_ << expr;                                   \
-      ::angio::log::write(lvl, angio_log_os_.str());           \
-    }                                                          \
+#define ANGIO_LOG(lvl, expr)                         \
+  do {                                               \
+    if (::angio::log::enabled(lvl)) {                \
+      std::ostringstream angio_log_os_;              \
+      angio_log_os_ << expr;                         \
+      ::angio::log::write(lvl, angio_log_os_.str()); \
+    }                                                \
   } while (0)
 #define LOG_DEBUG(expr) ANGIO_LOG(::angio::log::Level::debug, expr)
 #define LOG_INFO(expr) ANGIO_LOG(::angio::log::Level::info, expr)

@@ -61,10 +61,10 @@ class Centerline {
   // warped point map(θ, s, r) this returns exactly s and distance r (up to round-off), which a
   // plain distance to the polyline does not (its kinks are off by O(r·Δφ²)).
   struct Closest {
-    double s = 0;          // arc length (may be < 0 or > length() beyond the ends)
-    double distance = 0;   // |x − point(s)|: radial distance from the curved axis
+    double s = 0;         // arc length (may be < 0 or > length() beyond the ends)
+    double distance = 0;  // |x − point(s)|: radial distance from the curved axis
     Vec3 foot = Vec3::Zero();
-    Frame frame;           // frame(s)
+    Frame frame;                 // frame(s)
     Vec3 radial = Vec3::Zero();  // (x − foot)/distance, zero on the axis
   };
   Closest closest(const Vec3& x) const;

@@ -31,7 +31,7 @@ Buffer solid_solve_reply(const Header& h, const participant::SolveStats& stats, 
 Buffer step_end(const Header& h, std::uint32_t step, bool accept);
 Buffer ack(const Header& h);
 Buffer shutdown(const Header& h, const std::string& reason);
-Buffer error(const Header& h, const std::string& message, std::uint32_t step = 0,
-             std::uint32_t iteration = 0, const std::vector<double>& residual_history = {});
+Buffer error(const Header& h, const std::string& message, std::uint32_t step = 0, std::uint32_t iteration = 0,
+             const std::vector<double>& residual_history = {});
 
 }  // namespace angio::msg

@@ -46,8 +46,7 @@ template <class T>
 const T& payload_as(const fb::Envelope& env) {
   const T* p = env.payload_as<T>();
   if (!p)
-    throw ProtocolError(std::string("expected a ") +
-                        payload_name(fb::PayloadTraits<T>::enum_value) + " message, got " +
+    throw ProtocolError(std::string("expected a ") + payload_name(fb::PayloadTraits<T>::enum_value) + " message, got " +
                         payload_name(env.payload_type()));
   return *p;
 }

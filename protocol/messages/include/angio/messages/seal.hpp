@@ -1,5 +1,5 @@
-// Peer authentication (docs/reliability.md "Security"; docs/design.md §4.5): every message of a coupled run travels sealed with an
-// HMAC-SHA256 tag under the run's secret key, so only processes that can read the run's key file
+// Peer authentication (docs/reliability.md "Security"; docs/design.md §4.5): every message of a coupled run travels
+// sealed with an HMAC-SHA256 tag under the run's secret key, so only processes that can read the run's key file
 // (owner-only, in the owner-only run directory) can speak for the coupler or a participant. A
 // foreign peer on the run's endpoint, even one that knows the run id and the key expressions,
 // cannot forge a request or a reply. The tag covers the whole envelope (run id, sender, sequence

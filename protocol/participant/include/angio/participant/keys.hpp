@@ -10,12 +10,8 @@ namespace angio::participant::keys {
 inline std::string request(const std::string& run, const std::string& role, const std::string& verb) {
   return "angio/" + run + "/" + role + "/" + verb;
 }
-inline std::string serve(const std::string& run, const std::string& role) {
-  return "angio/" + run + "/" + role + "/*";
-}
-inline std::string alive(const std::string& run, const std::string& role) {
-  return "angio/" + run + "/alive/" + role;
-}
+inline std::string serve(const std::string& run, const std::string& role) { return "angio/" + run + "/" + role + "/*"; }
+inline std::string alive(const std::string& run, const std::string& role) { return "angio/" + run + "/alive/" + role; }
 inline std::string status(const std::string& run) { return "angio/" + run + "/status"; }
 
 }  // namespace angio::participant::keys

@@ -16,8 +16,7 @@ struct PenaltyLaw {
 inline PenaltyLaw penalty_law(double g, double g0, double eps) {
   if (g0 <= 0.0) return {0.5 * eps * g * g, -eps * g, eps};
   if (g <= 0.0) return {eps * (0.5 * g * g - 0.5 * g0 * g + g0 * g0 / 6.0), eps * (0.5 * g0 - g), eps};
-  return {eps * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0), 0.5 * eps * (g0 - g) * (g0 - g) / g0,
-          eps * (g0 - g) / g0};
+  return {eps * (g0 - g) * (g0 - g) * (g0 - g) / (6.0 * g0), 0.5 * eps * (g0 - g) * (g0 - g) / g0, eps * (g0 - g) / g0};
 }
 
 }  // namespace angio::participant

@@ -21,8 +21,8 @@ struct PlanePenalty {
   double gap = 0.0;                                 // mm (negative: penetration)
 };
 
-inline PlanePenalty plane_penalty(const Eigen::Vector3d& x, const Eigen::Vector3d& s,
-                                  const Eigen::Vector3d& n, double eps, double radius, double g0 = 0.0) {
+inline PlanePenalty plane_penalty(const Eigen::Vector3d& x, const Eigen::Vector3d& s, const Eigen::Vector3d& n,
+                                  double eps, double radius, double g0 = 0.0) {
   PlanePenalty out;
   const double g = out.gap = (x - s).dot(n) - radius;
   if (!(g < g0) || !(eps > 0.0)) return out;  // separated: no load

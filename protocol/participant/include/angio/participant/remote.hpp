@@ -39,8 +39,8 @@ struct ExchangeTiming {
 // (of the envelopes, without tags).
 class Channel {
  public:
-  Channel(const transport::Session& session, std::string run_id, fb::Role role,
-          std::chrono::milliseconds timeout, recording::Recorder* recorder, msg::RunKey key);
+  Channel(const transport::Session& session, std::string run_id, fb::Role role, std::chrono::milliseconds timeout,
+          recording::Recorder* recorder, msg::RunKey key);
 
   using Build = std::function<msg::Buffer(const msg::Header&)>;
   // Sends the request built by `build` to angio/<run>/<role>/<verb>, the verb being the payload's

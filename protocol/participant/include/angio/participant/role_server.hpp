@@ -18,8 +18,8 @@ struct ServeOptions {
   std::string endpoint;  // the coupler's endpoint to connect to
   std::string run_id;
   std::chrono::milliseconds timeout{600000};  // longest silence from the coupler before giving up
-  std::string software;  // name/version sent in the handshake
-  std::optional<msg::RunKey> key;  // the run's secret: requests must carry its tag, replies get it
+  std::string software;                       // name/version sent in the handshake
+  std::optional<msg::RunKey> key;             // the run's secret: requests must carry its tag, replies get it
 };
 
 // Options from the common command line (--endpoint, --run-id, --timeout, --key-file or

@@ -55,7 +55,7 @@ struct ContactReply {
   std::vector<std::uint8_t> active;
   double regularization = 0.0;  // g0 (mm) of the solid's line penalty law, 0 = linear (Eq. 4)
   int n_active = 0;
-  double min_gap = 0.0;  // most negative gap (largest penetration), mm
+  double min_gap = 0.0;             // most negative gap (largest penetration), mm
   Vec3 total_force{0.0, 0.0, 0.0};  // sum of w·q over the points (N)
 };
 

@@ -26,8 +26,7 @@ struct Exchange {
 class Recorder {
  public:
   Recorder(const std::string& path, const std::string& run_id);  // throws on I/O error
-  void add(fb::Role role, const std::string& verb, const msg::Buffer& request,
-           const msg::Buffer& reply);
+  void add(fb::Role role, const std::string& verb, const msg::Buffer& request, const msg::Buffer& reply);
   const std::string& path() const { return path_; }
 
  private:

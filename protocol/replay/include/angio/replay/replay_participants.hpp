@@ -1,7 +1,7 @@
-// Participants that answer from a recording instead of solving (docs/design.md §4.6). They implement the ordinary participant interfaces, so the ordinary role server
-// serves them, and the coupler cannot tell them from the real solvers. Each incoming request is
-// checked against the recorded one (same verb, step, accept flag; interface vectors equal within
-// a tolerance); a mismatch is an error naming the exchange.
+// Participants that answer from a recording instead of solving (docs/design.md §4.6). They implement the ordinary
+// participant interfaces, so the ordinary role server serves them, and the coupler cannot tell them from the real
+// solvers. Each incoming request is checked against the recorded one (same verb, step, accept flag; interface vectors
+// equal within a tolerance); a mismatch is an error naming the exchange.
 #pragma once
 
 #include <cstddef>
@@ -42,8 +42,7 @@ class Cursor {
 
 // Largest |a − b| over all components, relative to max(1, max|b|): the comparison used for
 // interface vectors (line loads, sample-point positions).
-double relative_difference(const std::vector<participant::Vec3>& a,
-                           const std::vector<participant::Vec3>& b);
+double relative_difference(const std::vector<participant::Vec3>& a, const std::vector<participant::Vec3>& b);
 
 class ReplayBeam : public participant::BeamParticipant {
  public:
@@ -64,8 +63,8 @@ class ReplaySolid : public participant::SolidParticipant {
  public:
   ReplaySolid(const recording::Recording& rec, double tolerance);
   void begin_step(int step, double time) override;
-  participant::SolveStats solve(const participant::SamplePoints& points,
-                                participant::ContactReply& reply, double tolerance) override;
+  participant::SolveStats solve(const participant::SamplePoints& points, participant::ContactReply& reply,
+                                double tolerance) override;
   void end_step(bool accept) override;
   void finish() override;
 

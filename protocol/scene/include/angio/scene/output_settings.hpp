@@ -6,7 +6,7 @@
 namespace angio::scene {
 
 struct OutputSettings {
-  int every = 1;       // fields at every `every`-th committed step (and the first)
+  int every = 1;  // fields at every `every`-th committed step (and the first)
   // A state file (<run>/<solver>/state.h5) rewritten at the steps with fields and at the end of the
   // run: the committed state a later run starts from (solid.initial_state, stent.initial_state).
   bool state = true;

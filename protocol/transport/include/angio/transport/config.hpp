@@ -8,7 +8,7 @@
 namespace angio::transport {
 
 struct SessionConfig {
-  std::vector<std::string> listen;   // must be bindable when the session opens
+  std::vector<std::string> listen;  // must be bindable when the session opens
   // Retried in the background until the peer listens; Session::open waits at most 0.5 s
   // for a first connection, so it never blocks on an absent peer.
   std::vector<std::string> connect;

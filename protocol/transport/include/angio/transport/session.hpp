@@ -41,8 +41,7 @@ class Session {
                 const Accept& accept = {}) const;
 
   // Single attempt: like request() but throws NoReplyError at once if no queryable answered.
-  Bytes request_once(const std::string& key, ByteView payload,
-                     std::chrono::milliseconds timeout) const;
+  Bytes request_once(const std::string& key, ByteView payload, std::chrono::milliseconds timeout) const;
 
   // Asks the network whether a liveliness token matching `key` is alive (waits at most
   // `timeout` for answers; a missing peer simply yields false).

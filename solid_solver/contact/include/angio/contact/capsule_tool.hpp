@@ -20,21 +20,21 @@
 namespace angio::contact {
 
 struct AxisDistance {
-  double r = 0.0;                 // distance from the polyline (mm)
-  Vec3 foot = Vec3::Zero();       // closest point on it
-  Vec3 e_r = Vec3::Zero();        // (x − foot)/r; zero on the axis
-  Mat3 P = Mat3::Identity();      // d(x − foot)/dx: I − t tᵀ inside a segment, I at a vertex
+  double r = 0.0;             // distance from the polyline (mm)
+  Vec3 foot = Vec3::Zero();   // closest point on it
+  Vec3 e_r = Vec3::Zero();    // (x − foot)/r; zero on the axis
+  Mat3 P = Mat3::Identity();  // d(x − foot)/dx: I − t tᵀ inside a segment, I at a vertex
 };
 
 // Closest point of the polyline (>= 2 points, segments of positive length) to x.
 AxisDistance polyline_distance(const std::vector<Vec3>& axis, const Vec3& x);
 
 struct ToolNodeContact {
-  bool active = false;            // r < R
-  double penetration = 0.0;       // R − r (mm) when active
-  double energy = 0.0;            // Π_a (N mm)
-  Vec3 r = Vec3::Zero();          // dΠ_a/dx (N): minus the force on the node
-  Mat3 K = Mat3::Zero();          // d²Π_a/dx² (N/mm)
+  bool active = false;       // r < R
+  double penetration = 0.0;  // R − r (mm) when active
+  double energy = 0.0;       // Π_a (N mm)
+  Vec3 r = Vec3::Zero();     // dΠ_a/dx (N): minus the force on the node
+  Mat3 K = Mat3::Zero();     // d²Π_a/dx² (N/mm)
 };
 
 // The penalty of the capsule of radius R on one node; eps_area = ε A_a (N/mm). A node on the axis

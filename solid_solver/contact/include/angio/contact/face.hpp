@@ -65,11 +65,11 @@ FaceX gather(const Face& f, std::span<const Vec3> coords);
 
 // Geometry of a face at xi.
 struct FacePoint {
-  Vec3 x;                 // position
-  Vec3 a1, a2;            // tangents x_,xi and x_,eta
-  Vec3 a11, a22, a12;     // second derivatives
-  Vec3 n;                 // unit normal, normal_sign * (a1 x a2)/|a1 x a2|
-  double j = 0.0;         // |a1 x a2| (area element per unit parameter area)
+  Vec3 x;              // position
+  Vec3 a1, a2;         // tangents x_,xi and x_,eta
+  Vec3 a11, a22, a12;  // second derivatives
+  Vec3 n;              // unit normal, normal_sign * (a1 x a2)/|a1 x a2|
+  double j = 0.0;      // |a1 x a2| (area element per unit parameter area)
 };
 FacePoint evaluate(FaceKind k, const FaceX& X, const Vec2& xi, double normal_sign = 1.0);
 
@@ -108,7 +108,9 @@ struct Aabb {
     hi.array() += r;
   }
   bool contains(const Vec3& p) const { return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all(); }
-  bool overlaps(const Aabb& b) const { return (lo.array() <= b.hi.array()).all() && (b.lo.array() <= hi.array()).all(); }
+  bool overlaps(const Aabb& b) const {
+    return (lo.array() <= b.hi.array()).all() && (b.lo.array() <= hi.array()).all();
+  }
   Vec3 center() const { return 0.5 * (lo + hi); }
 };
 // A box that contains the whole (curved) face: node hull for quad4/tri3 (bilinear/linear maps stay in the

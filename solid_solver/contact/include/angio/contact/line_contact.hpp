@@ -38,50 +38,50 @@ struct LineContactParams {
   //   q = f(g) nu, f_a = -w q N_a(xi), g = d - R, and K is the tangent with the nodal normals held
   //   fixed (not symmetric).
   bool averaged_normals = false;
-  bool compute_tangent = true;   // fill NodalContribution::K
-  bool beam_tangent = false;     // fill PointContact::dq_dx
+  bool compute_tangent = true;  // fill NodalContribution::K
+  bool beam_tangent = false;    // fill PointContact::dq_dx
   ProjectionOptions projection;
 };
 
 // Nodal residual/tangent contribution of one contact point (or Gauss point) to the solid.
 struct NodalContribution {
-  std::vector<int> nodes;   // node ids (as in the faces), 3 dofs each, dof = 3*local + component
+  std::vector<int> nodes;  // node ids (as in the faces), 3 dofs each, dof = 3*local + component
   // dPi/dX (= minus the contact forces) on the first r.size()/3 nodes; the nodes after them only enter the
   // tangent's columns (averaged normals: the ring around the face).
   Eigen::VectorXd r;
-  Eigen::MatrixXd K;        // dr/dX (r.size() x 3 nodes; symmetric for the closest-point and surface contact),
-                            // empty if no tangent requested
-  int surface = -1;         // line contact: index of the surface; surface contact: pass (0, or 1 if two_pass)
-  int point = -1;           // line contact: beam point index; surface contact: index into SurfaceContactResult::points
+  Eigen::MatrixXd K;  // dr/dX (r.size() x 3 nodes; symmetric for the closest-point and surface contact),
+                      // empty if no tangent requested
+  int surface = -1;   // line contact: index of the surface; surface contact: pass (0, or 1 if two_pass)
+  int point = -1;     // line contact: beam point index; surface contact: index into SurfaceContactResult::points
 };
 
 // One beam point against one surface.
 struct PointContact {
-  bool found = false;       // a face within the search radius
-  bool active = false;      // g < 0
+  bool found = false;   // a face within the search radius
+  bool active = false;  // g < 0
   int face = -1;
-  Projection proj;          // s, n (toward the beam), xi, location
-  double gap = 0.0;         // g = (x - s).n - R (only if found)
-  Vec3 q = Vec3::Zero();    // line load on the beam (N/mm)
-  double energy = 0.0;      // penalty potential w pi(g) of this pair (N mm)
-  Mat3 dq_dx = Mat3::Zero();// dq/dx with the surface fixed (if beam_tangent)
+  Projection proj;            // s, n (toward the beam), xi, location
+  double gap = 0.0;           // g = (x - s).n - R (only if found)
+  Vec3 q = Vec3::Zero();      // line load on the beam (N/mm)
+  double energy = 0.0;        // penalty potential w pi(g) of this pair (N mm)
+  Mat3 dq_dx = Mat3::Zero();  // dq/dx with the surface fixed (if beam_tangent)
 };
 
 struct ContactDiagnostics {
-  int num_points = 0;        // evaluated (point, surface) pairs with a closest point in range
-  int num_active = 0;        // with g < 0
+  int num_points = 0;  // evaluated (point, surface) pairs with a closest point in range
+  int num_active = 0;  // with g < 0
   double min_gap = std::numeric_limits<double>::infinity();  // smallest gap (most negative = largest penetration)
-  Vec3 force_on_solid = Vec3::Zero();  // sum of nodal forces on the solid (N)
-  double force_magnitude = 0.0;        // sum over points of |force| (N)
-  double energy = 0.0;                 // penalty potential Pi (N mm); r = dPi/dX
+  Vec3 force_on_solid = Vec3::Zero();                        // sum of nodal forces on the solid (N)
+  double force_magnitude = 0.0;                              // sum over points of |force| (N)
+  double energy = 0.0;                                       // penalty potential Pi (N mm); r = dPi/dX
   void merge(const ContactDiagnostics& o);
 };
 
 struct LineContactResult {
-  std::vector<Vec3> q;                                // per point: line load on the beam summed over surfaces
-  Vec3 force_on_beam = Vec3::Zero();                  // sum_i w_i q_i (N) = -diag.force_on_solid
-  std::vector<std::vector<PointContact>> per_surface; // [surface][point]
-  std::vector<NodalContribution> solid;               // active (point, surface) pairs
+  std::vector<Vec3> q;                                 // per point: line load on the beam summed over surfaces
+  Vec3 force_on_beam = Vec3::Zero();                   // sum_i w_i q_i (N) = -diag.force_on_solid
+  std::vector<std::vector<PointContact>> per_surface;  // [surface][point]
+  std::vector<NodalContribution> solid;                // active (point, surface) pairs
   ContactDiagnostics diag;
 };
 
@@ -91,12 +91,12 @@ struct LineContactResult {
 // sum). found = false: no surface within the search radius (s, n zero).
 struct RobinPoint {
   bool found = false;
-  bool active = false;    // g < 0
+  bool active = false;  // g < 0
   int surface = -1;
   Vec3 s = Vec3::Zero();
   Vec3 n = Vec3::Zero();  // unit normal toward the beam
   double gap = 0.0;
-  double penalty = 0.0;   // eps
+  double penalty = 0.0;  // eps
 };
 std::vector<RobinPoint> robin_points(const LineContactResult& res, double penalty);
 
@@ -114,7 +114,7 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
 
 // Evaluate all points against all surfaces (searches must be update()d with the current coordinates).
 // The contributions of different surfaces add up (a point may touch balloon and artery at the same time).
-LineContactResult evaluate_line_contact(std::span<const BeamPoint> points, std::span<const SurfaceSearch* const> surfaces,
-                                        const LineContactParams& par);
+LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
+                                        std::span<const SurfaceSearch* const> surfaces, const LineContactParams& par);
 
 }  // namespace angio::contact

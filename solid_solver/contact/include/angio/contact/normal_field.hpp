@@ -24,8 +24,8 @@ namespace angio::contact {
 // faces around it (the node's "ring", itself included).
 struct NodeNormal {
   Vec3 n = Vec3::Zero();
-  std::vector<int> ring;     // node ids
-  Eigen::MatrixXd dn;        // dn/dX_ring (3 x 3 ring.size())
+  std::vector<int> ring;  // node ids
+  Eigen::MatrixXd dn;     // dn/dX_ring (3 x 3 ring.size())
 };
 
 // Averaged nodal normals of a surface: `node[id]` for every node id used by a face (ids index an array of
@@ -39,7 +39,7 @@ struct NodalNormals {
 void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out);
 
 struct NormalFieldProjection {
-  bool valid = false;      // Newton converged and xi lies in the face (tolerance `inside_tol`)
+  bool valid = false;  // Newton converged and xi lies in the face (tolerance `inside_tol`)
   Vec2 xi = Vec2::Zero();
   Vec3 s = Vec3::Zero();   // x_s(xi)
   Vec3 nu = Vec3::Zero();  // unit normal of the field at xi
@@ -56,12 +56,12 @@ NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const Fa
 // n_0 (3), ..., n_{nn-1} (3)]: the point, the face's nodes and its nodal normals taken as independent
 // (NodeNormal::dn chains the normals to the nodes around the face).
 struct NormalFieldLinearization {
-  int m = 0;                // 3 + 6 nn
-  ShapeN N;                 // shape functions at xi
-  ShapeD dN;                // their derivatives
-  Eigen::MatrixXd dxi;      // dxi/du (2 x m)
-  Eigen::RowVectorXd dd;    // dd/du (1 x m)
-  Eigen::MatrixXd dnu;      // dnu/du (3 x m)
+  int m = 0;              // 3 + 6 nn
+  ShapeN N;               // shape functions at xi
+  ShapeD dN;              // their derivatives
+  Eigen::MatrixXd dxi;    // dxi/du (2 x m)
+  Eigen::RowVectorXd dd;  // dd/du (1 x m)
+  Eigen::MatrixXd dnu;    // dnu/du (3 x m)
 };
 void linearize(FaceKind k, const FaceX& X, const FaceX& Nn, const NormalFieldProjection& p,
                NormalFieldLinearization& out);

@@ -9,7 +9,7 @@ enum class Location { Interior, Edge, Corner };
 const char* name(Location l);
 
 struct ProjectionOptions {
-  double tol = 1e-13;    // Newton step tolerance in parameter space
+  double tol = 1e-13;  // Newton step tolerance in parameter space
   int max_iter = 40;
   double inside_tol = 1e-10;  // parameter-space tolerance for accepting an interior solution
   // Newton starts from the closest of a few sample points (9 on quads, 7 on triangles). If it does not converge to
@@ -18,8 +18,8 @@ struct ProjectionOptions {
   // points, the best minimum is kept and compared with the edge minima.
   bool multi_start = true;
   double trust_eigenvalue = 0.5;
-  bool check_edges = true;    // also minimize over the edges after an interior solution (global minimum on
-                              // strongly curved faces); false: edges only if no interior minimum was found
+  bool check_edges = true;  // also minimize over the edges after an interior solution (global minimum on
+                            // strongly curved faces); false: edges only if no interior minimum was found
 };
 
 // Result of projecting x onto one face (minimizing |x - x_s(xi)| over the parameter domain).
@@ -32,30 +32,29 @@ struct ProjectionOptions {
 struct Projection {
   bool valid = false;
   Location location = Location::Interior;
-  int index = -1;          // edge or corner index (Edge/Corner)
-  double t = 0.0;          // edge parameter (Edge)
-  Vec2 xi = Vec2::Zero();  // parameter coordinates of s
-  Vec3 s = Vec3::Zero();   // closest point
-  Vec3 n = Vec3::Zero();   // unit contact normal (toward the side of x for edge/corner; face normal inside)
+  int index = -1;              // edge or corner index (Edge/Corner)
+  double t = 0.0;              // edge parameter (Edge)
+  Vec2 xi = Vec2::Zero();      // parameter coordinates of s
+  Vec3 s = Vec3::Zero();       // closest point
+  Vec3 n = Vec3::Zero();       // unit contact normal (toward the side of x for edge/corner; face normal inside)
   Vec3 n_face = Vec3::Zero();  // normal_sign * face normal at s
-  double distance = 0.0;   // |x - s|
-  double d = 0.0;          // signed distance (x - s) . n
+  double distance = 0.0;       // |x - s|
+  double d = 0.0;              // signed distance (x - s) . n
   int iterations = 0;
 };
 
-Projection project(FaceKind k, const FaceX& X, double normal_sign, const Vec3& x,
-                   const ProjectionOptions& opt = {});
+Projection project(FaceKind k, const FaceX& X, double normal_sign, const Vec3& x, const ProjectionOptions& opt = {});
 
 // Derivatives of d = (x - s) . n (s, n from `p`) with respect to u = [x (3), X_0 (3), ..., X_{nn-1} (3)],
 // where x and the face nodes are independent variables; the closest point
 // (xi) and the normal follow from the projection conditions.
 struct GapLinearization {
-  int m = 0;               // 3 + 3 nn
-  ShapeN N;                // shape functions at s
-  Eigen::RowVectorXd dd;   // dd/du (1 x m)
-  Eigen::MatrixXd dn;      // dn/du (3 x m)
-  Eigen::MatrixXd dxi;     // dxi/du (2 x m)
-  Eigen::MatrixXd hd;      // d2d/du2 (m x m), only if requested
+  int m = 0;              // 3 + 3 nn
+  ShapeN N;               // shape functions at s
+  Eigen::RowVectorXd dd;  // dd/du (1 x m)
+  Eigen::MatrixXd dn;     // dn/du (3 x m)
+  Eigen::MatrixXd dxi;    // dxi/du (2 x m)
+  Eigen::MatrixXd hd;     // d2d/du2 (m x m), only if requested
 };
 void linearize(FaceKind k, const FaceX& X, double normal_sign, const Vec3& x, const Projection& p, bool hessian,
                GapLinearization& out);

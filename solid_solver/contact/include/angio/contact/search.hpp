@@ -63,8 +63,8 @@ class SurfaceSearch {
   void candidates(const Aabb& b, std::vector<int>& faces) const;
   // Closest point over the candidate faces (ties: lowest face index); found only if distance <= radius.
   SurfaceProjection closest(const Vec3& p, const ProjectionOptions& opt = {}) const;
-  // Projection along the averaged nodal normal field (enable_normal_field()) over the candidate faces: the valid one with the smallest |d|
-  // (ties: lowest face index); found only if |d| <= radius.
+  // Projection along the averaged nodal normal field (enable_normal_field()) over the candidate faces: the valid one
+  // with the smallest |d| (ties: lowest face index); found only if |d| <= radius.
   SurfaceNormalProjection along_normals(const Vec3& p, double inside_tol = 1e-10) const;
   // Same over all faces (reference for tests; ignores the tree but applies the radius).
   SurfaceProjection closest_brute_force(const Vec3& p, const ProjectionOptions& opt = {}) const;

@@ -18,24 +18,25 @@
 namespace angio::contact {
 
 struct SurfaceContactParams {
-  double penalty = 5.0;          // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see solid_solver/contact/README.md
-  int quadrature_degree = 3;     // slave quadrature (face_rule): quad 2x2, tri 6 points
-  double regularization = 0.0;   // g0 (mm): C1 law, active where g_N < g0; 0: the paper's quadratic potential
-  bool two_pass = false;         // symmetric: both surfaces act as slave, each pass with eps/2
+  double penalty = 5.0;         // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see
+                                // solid_solver/contact/README.md
+  int quadrature_degree = 3;    // slave quadrature (face_rule): quad 2x2, tri 6 points
+  double regularization = 0.0;  // g0 (mm): C1 law, active where g_N < g0; 0: the paper's quadratic potential
+  bool two_pass = false;        // symmetric: both surfaces act as slave, each pass with eps/2
   bool compute_tangent = true;
   ProjectionOptions projection;
 };
 
 struct GaussPointContact {
-  int pass = 0;            // 0: slave->master, 1: master->slave (two_pass)
+  int pass = 0;  // 0: slave->master, 1: master->slave (two_pass)
   int slave_face = -1, master_face = -1;
-  int gauss_point = -1;    // index in the slave face rule
-  Vec3 x = Vec3::Zero();   // Gauss point
-  Vec3 s = Vec3::Zero();   // closest point on the master
-  Vec3 n = Vec3::Zero();   // master contact normal
-  double gap = 0.0;        // g_N
-  double pressure = 0.0;   // contact pressure (MPa): -eps <g_N>, or the regularized law's
-  double area = 0.0;       // W = w_g j (mm^2)
+  int gauss_point = -1;   // index in the slave face rule
+  Vec3 x = Vec3::Zero();  // Gauss point
+  Vec3 s = Vec3::Zero();  // closest point on the master
+  Vec3 n = Vec3::Zero();  // master contact normal
+  double gap = 0.0;       // g_N
+  double pressure = 0.0;  // contact pressure (MPa): -eps <g_N>, or the regularized law's
+  double area = 0.0;      // W = w_g j (mm^2)
   bool active = false;
   Location location = Location::Interior;
 };
