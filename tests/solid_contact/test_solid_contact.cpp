@@ -402,6 +402,14 @@ TEST(ContactScene, ReadsAndValidates) {
     EXPECT_EQ(s.balloon_artery->quadrature, 5);
     EXPECT_EQ(s.balloon_artery->search_radius, 0.2);
     EXPECT_EQ(s.search_radius, 0.2);
+    EXPECT_EQ(s.balloon_artery->slave, "balloon_outer");
+    EXPECT_EQ(s.balloon_artery->regularization, 0.0);
+  }
+  {  // the lumen's Gauss points projected onto the balloon; the C1 law below 10 µm
+    const auto s = read_contact_spec(node("contact: {balloon_artery: {slave: artery, regularization: 0.01}}"));
+    EXPECT_EQ(s.balloon_artery->slave, "artery_inner");
+    EXPECT_EQ(s.balloon_artery->master, "balloon_outer");
+    EXPECT_EQ(s.balloon_artery->regularization, 0.01);
   }
   auto error = [&](const char* y) {
     try {
@@ -415,6 +423,9 @@ TEST(ContactScene, ReadsAndValidates) {
   EXPECT_NE(error("contact: {stent_balloon: {penalty: -1}}").find("contact.stent_balloon.penalty"), std::string::npos);
   EXPECT_NE(error("contact: {balloon_artery: {penalti: 1}}").find("contact.balloon_artery.penalti"), std::string::npos);
   EXPECT_NE(error("contact: {search_radius: 0}").find("contact.search_radius"), std::string::npos);
+  EXPECT_NE(error("contact: {balloon_artery: {slave: stent}}").find("contact.balloon_artery.slave"), std::string::npos);
+  EXPECT_NE(error("contact: {balloon_artery: {regularization: 0.2}}").find("contact.balloon_artery.regularization"),
+            std::string::npos);
   EXPECT_NE(error("contact: {stent_artery: maybe}").find("contact.stent_artery"), std::string::npos);
 }
 
