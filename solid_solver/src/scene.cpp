@@ -257,9 +257,10 @@ PressureSpec read_pressure(const Node& parent, const std::string& key, const std
   const double peak = std::max(std::abs(lo), std::abs(hi));
   if (peak > max_peak) {
     std::ostringstream m;
-    m << "a peak pressure (value x load curve) of at most " << max_peak << " MPa (" << limit_reason << "), got " << peak
-      << " MPa";
-    parent.child(key).fail(m.str());
+    m << "a value whose peak pressure (value x load curve) is at most " << max_peak << " MPa (" << limit_reason
+      << "); here it peaks at " << peak << " MPa";
+    const scene::Node p = parent.child(key);
+    (p.has("value") ? p.child("value") : p).fail(m.str());
   }
   return PressureSpec{surface, c.value, c.curve, label};
 }

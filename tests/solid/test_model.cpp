@@ -625,6 +625,28 @@ TEST(Scene, ViscousActsOnIsCheckedAndDefaultsToIsotropic) {
   }
 }
 
+// A physically absurd pressure inside the number type's range (1e6 MPa on the shipped straight scene)
+// is refused before anything runs, naming the value's key and the bound.
+TEST(Scene, AbsurdBalloonPressureIsRefusedNamingTheValue) {
+  std::ifstream in(std::string(ANGIO_CONFIGS_DIR) + "/straight_free_expansion.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "pressure: {value: 1.0, curve: pressure}";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.replace(text.find(key), key.size(), "pressure: {value: 1.0e6, curve: pressure}");
+  const std::string path = std::filesystem::temp_directory_path() / ("angio_pressure_" + std::to_string(getpid()) +
+                                                                     "_" + std::to_string(world_rank()) + ".yaml");
+  std::ofstream(path) << text;
+  try {
+    read_solid_scene(angio::scene::load_scene(path));
+    ADD_FAILURE() << "expected SceneError";
+  } catch (const angio::scene::SceneError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("balloon.pressure.value"), std::string::npos) << w;
+    EXPECT_NE(w.find("at most 4 MPa"), std::string::npos) << w;
+  }
+  std::filesystem::remove(path);
+}
+
 // solid.newton.atol is judged against the norm of the peak pressure load (load_scale.hpp): at
 // kMaxAtolOfLoad of it the scene is refused naming the key, just below it is accepted. Consistency
 // with the scene's own load norm (the straight scene's Newton ladder of scripts/work_precision.py: atol ~ the load norm
