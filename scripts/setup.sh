@@ -9,7 +9,7 @@ PACKAGES=(
   petsc-dev libopenmpi-dev openmpi-bin libhdf5-openmpi-dev libhdf5-dev
   flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev nlohmann-json3-dev libssl-dev
   libgtest-dev googletest
-  python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml python3-gmsh
+  python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml python3-gmsh python3-meshio
   # studies as Slurm job arrays (scripts/study.py --runner slurm); the test starts its own one-node cluster
   slurm-client slurmctld slurmd munge
   # participants in separate network namespaces (tests/integration/test_network_namespaces.py)
