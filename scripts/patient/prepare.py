@@ -21,13 +21,17 @@ from pathlib import Path
 import numpy as np
 
 from .artery_mesh import WallSpec, build_artery, layer_radii
-from .centerline_csv import read_centerline_csv
+from .centerline_csv import read_centerline_csv, write_centerline_csv
 from .errors import PatientInputError
+from .lumen_centerline import lumen_centerline
+from .lumen_surface import UNITS, read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 
 # key: (kind, default); kind is the expected type; None default = required
 KEYS = {
-    "centerline": ("path", None),
+    # exactly one of: a lumen centerline CSV, or a lumen surface (its centerline computed, lumen_centerline.py)
+    "centerline": ("path", ""),
+    "lumen_surface": ("map", {}),
     "stenosis": ("auto_or_number", "auto"),
     "wall": ("map", {}),
     "mesh": ("map", {}),
@@ -41,6 +45,7 @@ WALL_KEYS = {
     "adventitia_ratio": ("fraction", 0.065),
     "min_intima": ("positive", 0.05),
 }
+SURFACE_KEYS = {"file": ("path", None), "units": ("units", "mm"), "spacing": ("positive", 0.2)}
 MESH_KEYS = {"size": ("positive", 0.8), "binary": ("bool", True), "loft_spacing": ("positive", 0.5)}
 SPLINE_KEYS = {"smoothing": ("positive", 4.0), "clearance": ("non_negative", 0.0)}
 # A lesion narrower than a crimped device: a rigid capsule along the balloon axis (contact.insertion)
@@ -89,6 +94,8 @@ def _check_map(value, spec, where, scene_path):
             bad = "auto (open a lesion narrower than the devices with the virtual insertion tool) or off"
         elif kind == "map" and not isinstance(v, dict):
             bad = "a map"
+        elif kind == "units" and v not in UNITS:
+            bad = "a length unit, one of " + ", ".join(UNITS)
         if bad:
             raise PatientInputError(f"{scene_path}: {where}.{k}: expected {bad}, got {v!r}")
         out[k] = v
@@ -224,6 +231,29 @@ def _write_points(path, pts, comment):
             f.write(f"{p[0]:.9f} {p[1]:.9f} {p[2]:.9f}\n")
 
 
+def lumen_csv(pat, scene_path, out_dir, log):
+    """The lumen centerline CSV of the scene: patient.centerline as given, or the one computed from
+    patient.lumen_surface into out_dir/lumen_from_surface.csv."""
+    given = [k for k in ("centerline", "lumen_surface") if pat[k]]
+    if len(given) != 1:
+        raise PatientInputError(
+            f"{scene_path}: patient: expected exactly one of centerline (a CSV) and lumen_surface "
+            f"({{file, units}}), got {' and '.join(given) or 'neither'}"
+        )
+    if pat["centerline"]:
+        return (scene_path.parent / pat["centerline"]).resolve()
+    spec = _check_map(pat["lumen_surface"], SURFACE_KEYS, "patient.lumen_surface", scene_path)
+    path = (scene_path.parent / spec["file"]).resolve()
+    surface = read_lumen_surface(str(path), spec["units"])
+    points, radius = lumen_centerline(surface, spacing=spec["spacing"])
+    out = out_dir / "lumen_from_surface.csv"
+    write_centerline_csv(
+        out, points, radius, comment=f"lumen centerline of {path} (scripts/patient/lumen_centerline.py)"
+    )
+    log(f"patient: lumen surface {path.name}: {len(surface.triangles)} triangles -> {len(points)} centerline stations")
+    return out
+
+
 def prepare_scene(scene, scene_path, out_dir, log=print):
     """The completed scene (a new dict) with its generated files in out_dir; PatientInputError on bad input."""
     scene_path = Path(scene_path)
@@ -242,9 +272,14 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         )
     dev = device_of(scene, scene_path)
 
-    csv_path = (scene_path.parent / pat["centerline"]).resolve()
+    csv_path = lumen_csv(pat, scene_path, Path(out_dir), log)
     cl = read_centerline_csv(csv_path)
     if wall["thickness"] == "from_centerline":
+        if pat["lumen_surface"]:
+            raise PatientInputError(
+                f"{scene_path}: patient.wall.thickness: expected a number (mm) with patient.lumen_surface "
+                "(a lumen surface carries no wall thickness)"
+            )
         if cl.wall is None:
             raise PatientInputError(
                 f"{scene_path}: patient.wall.thickness: expected a number (mm), as {csv_path} "

@@ -32,22 +32,22 @@ RC, ANGLE, NC, NA = 20.0, 0.6, 48, 120
 LENGTH = RC * ANGLE
 
 
-def radius(s):
-    x = (s - LENGTH / 2) / 2.0
+def radius(s, length=LENGTH):
+    x = (s - length / 2) / 2.0
     return 1.5 * (1 - 0.4 * np.where(np.abs(x) < 1, 0.5 * (1 + np.cos(np.pi * x)), 0.0))
 
 
-def tube(caps=0):
+def tube(caps=0, rc=RC, angle=ANGLE):
     """Points and triangles of the curved stenosed tube; caps: 0, 1 or 2 ends closed by a fan."""
-    s = np.linspace(0, LENGTH, NA + 1)
-    th = s / RC
+    s = np.linspace(0, rc * angle, NA + 1)
+    th = s / rc
     phi = np.linspace(0, 2 * np.pi, NC, endpoint=False)
     pts = []
     for i in range(NA + 1):
-        c = np.array([RC * np.cos(th[i]), RC * np.sin(th[i]), 0.0])
+        c = np.array([rc * np.cos(th[i]), rc * np.sin(th[i]), 0.0])
         n1 = np.array([np.cos(th[i]), np.sin(th[i]), 0.0])
         for p in phi:
-            pts.append(c + radius(s[i]) * (np.cos(p) * n1 + np.sin(p) * np.array([0, 0, 1.0])))
+            pts.append(c + radius(s[i], rc * angle) * (np.cos(p) * n1 + np.sin(p) * np.array([0, 0, 1.0])))
     tris = []
     for i in range(NA):
         for j in range(NC):
@@ -127,6 +127,37 @@ class LumenSurface(unittest.TestCase):
         r, _ = self.run_cmd(os.path.join(self.tmp, "nothing.stl"))
         self.assertEqual(r.returncode, 2)
         self.assertIn("no such file", r.stderr)
+
+    def test_patient_pipeline_from_a_surface(self):
+        """patient.lumen_surface instead of patient.centerline: the shipped patient-like scene's devices
+        placed at the stenosis of the curved tube given as STL only (devices shortened to fit its 12 mm)."""
+        import yaml
+
+        from patient.prepare import prepare_scene
+
+        surface = self.write(*tube(), "vessel.stl")
+        with open(os.path.join(ROOT, "configs", "patient_like.yaml")) as f:
+            scene = yaml.safe_load(f)
+        scene["patient"]["lumen_surface"] = {"file": surface}
+        del scene["patient"]["centerline"]
+        scene["patient"]["wall"]["thickness"] = 0.6
+        scene["patient"]["mesh"]["size"] = 1.0  # coarse: this test is about the lumen
+        scene["balloon"]["mesh"].update(length=8.0, n_axial=50)
+        scene["stent"]["generator"].update(rings=3, ring_pitch=1.5)
+        scene_path = os.path.join(self.tmp, "scene.yaml")
+        out = os.path.join(self.tmp, "prepared")
+        os.makedirs(out)
+        done, report = prepare_scene(scene, scene_path, out, log=lambda m: None)
+        self.assertTrue(os.path.isfile(os.path.join(out, "lumen_from_surface.csv")))
+        self.assertAlmostEqual(report["lumen_length"], LENGTH, delta=0.1)
+        self.assertAlmostEqual(min(report["lumen_diameter_range"]), 1.8, delta=0.02)  # 40 % of 3 mm
+        # both keys, or a thickness from a column the surface does not have: refused naming the key
+        both = dict(scene, patient=dict(scene["patient"], centerline="x.csv"))
+        with self.assertRaisesRegex(PatientInputError, "exactly one of centerline"):
+            prepare_scene(both, scene_path, out, log=lambda m: None)
+        col = dict(scene, patient=dict(scene["patient"], wall={"thickness": "from_centerline"}))
+        with self.assertRaisesRegex(PatientInputError, "patient.wall.thickness"):
+            prepare_scene(col, scene_path, out, log=lambda m: None)
 
     def test_mixed_orientation_is_repaired(self):
         pts, tris = tube()
