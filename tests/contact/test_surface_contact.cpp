@@ -46,17 +46,24 @@ Vec3 net_force(const SurfaceContactResult& r, const std::vector<int>& nodes_filt
 }
 }  // namespace
 
+namespace {
+// Contact of the slave patch against the master patch of `t`, the searches updated to its coordinates.
+SurfaceContactResult patches_contact(const TwoPatches& t, const SurfaceContactParams& par) {
+  SurfaceSearch Ss(t.slave, 0.1), Sm(t.master, 0.1);
+  Ss.update(t.all.x);
+  Sm.update(t.all.x);
+  return evaluate_surface_contact(Ss, Sm, par);
+}
+}  // namespace
+
 // Compares against: the exact total force eps * penetration * overlap area for two parallel flat patches
 // (non-matching meshes, slave fully inside the master), and equal and opposite forces on the two sides.
 TEST(SurfaceContact, ParallelPatchesExactForceAndBalance) {
   const double eps = 5.0, pen = 0.01;
   TwoPatches t = two_patches(0.5, 1.5, 0.3, 1.7, 3, 5, pen);
-  SurfaceSearch Ss(t.slave, 0.1), Sm(t.master, 0.1);
-  Ss.update(t.all.x);
-  Sm.update(t.all.x);
   SurfaceContactParams par;
   par.penalty = eps;
-  const SurfaceContactResult r = evaluate_surface_contact(Ss, Sm, par);
+  const SurfaceContactResult r = patches_contact(t, par);
   const double area = 1.0 * 1.4;
   EXPECT_EQ(r.diag.num_active, 15 * 4);
   EXPECT_NEAR(r.active_area, area, 1e-13);
@@ -78,13 +85,10 @@ TEST(SurfaceContact, ParallelPatchesExactForceAndBalance) {
 TEST(SurfaceContact, TwoPassParallelPatches) {
   const double eps = 5.0, pen = 0.02;
   TwoPatches t = two_patches(0.5, 1.5, 0.5, 1.5, 3, 3, pen);
-  SurfaceSearch Ss(t.slave, 0.1), Sm(t.master, 0.1);
-  Ss.update(t.all.x);
-  Sm.update(t.all.x);
   SurfaceContactParams par;
   par.penalty = eps;
   par.two_pass = true;
-  const SurfaceContactResult r = evaluate_surface_contact(Ss, Sm, par);
+  const SurfaceContactResult r = patches_contact(t, par);
   std::vector<int> master_nodes(25);
   std::iota(master_nodes.begin(), master_nodes.end(), 0);
   const int n = static_cast<int>(t.all.x.size());
@@ -200,19 +204,16 @@ TEST(SurfaceContact, RegularizedTangentMatchesFiniteDifferences) {
 TEST(SurfaceContact, RegularizedParallelPatchesExactPressure) {
   const double eps = 5.0, g0 = 0.04, gap = 0.01;
   TwoPatches t = two_patches(0.5, 1.5, 0.3, 1.7, 3, 5, -gap);
-  SurfaceSearch Ss(t.slave, 0.1), Sm(t.master, 0.1);
-  Ss.update(t.all.x);
-  Sm.update(t.all.x);
   SurfaceContactParams par;
   par.penalty = eps;
   par.regularization = g0;
-  const SurfaceContactResult r = evaluate_surface_contact(Ss, Sm, par);
+  const SurfaceContactResult r = patches_contact(t, par);
   const double p = eps * (g0 - gap) * (g0 - gap) / (2.0 * g0), area = 1.0 * 1.4;
   EXPECT_EQ(r.diag.num_active, 15 * 4);
   for (const auto& gp : r.points) EXPECT_NEAR(gp.pressure, p, 1e-14);
   EXPECT_NEAR(r.diag.force_on_solid.z(), -p * area, 1e-13);
   par.regularization = 0.5 * gap;
-  EXPECT_EQ(evaluate_surface_contact(Ss, Sm, par).diag.num_active, 0);
+  EXPECT_EQ(patches_contact(t, par).diag.num_active, 0);
 }
 
 // Compares against: the analytic penetration of a balloon-like tube (slave, outer radius 1.02) inside an
