@@ -3,7 +3,8 @@
 Each task runs `scripts/study.py case STUDY --index I --key K`, i.e. the same `run_case` as the local
 pool, inside its allocation: the launcher starts the coupler and the beam in the task's batch step and
 the solid's ranks with `srun` (scripts/launch.py --mpi-launcher auto; tcp endpoints when the
-allocation spans nodes). A task asks for the solid's ranks plus one core for the coupler and the beam.
+allocation spans nodes). A task asks for one core per solid rank: the coupler and the beam run beside the
+solid's first rank (they wait while the solid solves: a few percent of a core together).
 Slurm schedules; nothing of ours waits or polls (`status` reads the case files).
 """
 import json
@@ -31,7 +32,7 @@ def sbatch_path():
 def array_script(study, cases, out_dir, build_dir, list_path, python, root):
     """The batch script of one array over `cases` (the lines of list_path: index key)."""
     s = study.slurm
-    ntasks = max(study.ranks(c) for c in cases) + 1
+    ntasks = max(study.ranks(c) for c in cases)
     n = len(cases)
     array = f"0-{n - 1}" + (f"%{s['max_parallel']}" if s.get("max_parallel") else "")
     logs = os.path.join(out_dir, "slurm", "task-%A_%a.out")

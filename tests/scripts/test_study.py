@@ -9,7 +9,7 @@ same inputs: equal to 1e-9 mm). Robustness: unknown keys and key paths, an empty
 cases, a second study in one directory and a Slurm runner without sbatch are exit 2 with the file
 and key named and nothing run or submitted; a rerun skips finished cases, runs stopped ones and
 failed ones only with --retry-failed.
-Usage: test_study.py BIN_DIR   (about 60 s)
+Usage: test_study.py BIN_DIR   (about 60 s on an idle machine)
 """
 import csv
 import json
@@ -35,7 +35,7 @@ PRESSURES = [0.8, 1.0, 1.2]
 def study_text(**extra):
     doc = {
         "base": TINY,
-        "common": {"solid.ranks": 1},
+        "common": {"solid.ranks": 2},  # 2 ranks: srun starts a real MPI job in every task
         "grid": {"balloon.pressure.value": PRESSURES},
         "plot": {"x": "balloon.pressure.value", "y": ["stent.final"]},
     }
