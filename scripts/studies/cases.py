@@ -122,20 +122,24 @@ def run_case(study, case, out_dir, build_dir, quiet=True):
         write_json(os.path.join(d, "case.json"), info)
         log_path = os.path.join(d, "launch.log")
         t0 = time.time()
-        with variant_scene(
-            study.base_path,
-            case.scene,
-            f"study_{case.key}",
-            f"case {case.key} of study {study.name} (scripts/study.py)",
-        ) as path:
-            with open(log_path, "w") as log:
-                rc = subprocess.call(launch_command(path, run_dir, build_dir), stdout=log, stderr=subprocess.STDOUT)
+        try:
+            with variant_scene(
+                study.base_path,
+                case.scene,
+                f"study_{case.key}",
+                f"case {case.key} of study {study.name} (scripts/study.py)",
+            ) as path:
+                with open(log_path, "w") as log:
+                    rc = subprocess.call(launch_command(path, run_dir, build_dir), stdout=log, stderr=subprocess.STDOUT)
+            message = "" if rc == 0 else last_error(log_path)
+        except OSError as e:  # the scene beside its base, or the log, cannot be written: this case fails
+            rc, message = 1, f"cannot start the case: {e}"
         info.update(
             state="done" if rc == 0 else "failed",
             exit_code=rc,
             wall_s=round(time.time() - t0, 3),
             finished=time.strftime("%Y-%m-%dT%H:%M:%S"),
-            message="" if rc == 0 else last_error(log_path),
+            message=message,
         )
         write_json(os.path.join(d, "case.json"), info)
         return info
