@@ -48,8 +48,13 @@ def fail(msg):
 def check_scenes(study, cases, build_dir):
     """launch.py --check of every case's scene: a bad value anywhere stops the study before it runs."""
     for c in cases:
-        with variant_scene(study.base_path, c.scene, f"study_check_{c.key}", "checked by scripts/study.py") as path:
-            out = subprocess.run(launch_command(path, "unused", build_dir, "--check"), capture_output=True, text=True)
+        try:
+            with variant_scene(study.base_path, c.scene, f"study_check_{c.key}", "checked by scripts/study.py") as path:
+                out = subprocess.run(
+                    launch_command(path, "unused", build_dir, "--check"), capture_output=True, text=True
+                )
+        except OSError as e:  # each case's scene is written beside the base (its relative paths resolve there)
+            fail(f"{study.where}: base: cannot write a case's scene beside {study.base_path}: {e.strerror}")
         if out.returncode != 0:
             why = (out.stderr.strip() or out.stdout.strip()).splitlines()
             why = why[-1] if why else out.returncode
