@@ -240,7 +240,7 @@ def free_tcp_port(host="127.0.0.1"):
 def pick_endpoint(run_dir, transport):
     if transport == "auto" and in_slurm_allocation() and int(os.environ.get("SLURM_JOB_NUM_NODES", "1")) > 1:
         # ranks on other nodes cannot reach a unix socket or the loopback of this one
-        return f"tcp/{socket.gethostbyname(socket.gethostname())}:{free_tcp_port('0.0.0.0')}"
+        return f"tcp/{host_address()}:{free_tcp_port('0.0.0.0')}"
     sock = (run_dir / "coupler.sock").resolve()
     if transport == "unix" or (transport == "auto" and len(str(sock)) <= UNIX_PATH_MAX - 1):
         if len(str(sock)) > UNIX_PATH_MAX - 1:
@@ -249,6 +249,22 @@ def pick_endpoint(run_dir, transport):
             sock.unlink()
         return f"unixsock-stream/{sock}"
     return f"tcp/127.0.0.1:{free_tcp_port()}"
+
+
+def host_address():
+    """This host's address as other nodes reach it: a non-loopback IPv4 address its name resolves to
+    (Debian maps the host name to 127.0.1.1 in /etc/hosts when it has no other)."""
+    try:
+        infos = socket.getaddrinfo(socket.gethostname(), None, socket.AF_INET)
+    except OSError:
+        infos = []
+    routable = sorted(a for a in {ai[4][0] for ai in infos} if not a.startswith("127."))
+    if not routable:
+        die(
+            f"{socket.gethostname()} resolves to no address other nodes can reach; "
+            "pass --endpoint tcp/<this node's address>:<port>"
+        )
+    return routable[0]
 
 
 def in_slurm_allocation():
