@@ -6,8 +6,9 @@ Antiga et al. 2003 for vessels), has level sets that are closed loops around the
 its cross-sections. Each level set gives a station: the centroid of the loop (a point of the
 centerline) and the area it encloses A (the norm of 1/2 sum p x q over its segments), i.e. the
 equivalent lumen radius sqrt(A/pi) that the centerline CSV carries. The stations are resampled at a
-uniform arc-length spacing. A level set of more than one loop (a side branch, a surface that folds
-back) is refused: the pipeline builds one vessel. Units: mm."""
+uniform arc-length spacing. A level set of more than one loop (a handle, a surface that folds back)
+is refused: the pipeline builds one vessel (side branches, which add boundary loops, are refused
+when the surface is read). Units: mm."""
 import numpy as np
 import scipy.sparse
 import scipy.sparse.linalg
@@ -120,7 +121,7 @@ def lumen_centerline(surface, spacing=0.2, levels=400):
         if loops != 1:
             raise PatientInputError(
                 f"{surface.path}: the section at fraction {c:.3f} of the vessel has {loops} loops, expected one "
-                "(a side branch or a fold: cut branches off the surface)"
+                "(a handle or a fold of the surface)"
             )
         stations.append(centroid)
         radii.append(np.sqrt(np.linalg.norm(area) / np.pi))

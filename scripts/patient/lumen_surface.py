@@ -63,6 +63,7 @@ def read_lumen_surface(path, units="mm"):
         raise PatientInputError(
             f"{path}: expected a lumen open at both ends (2 boundary loops), got {len(loops)}"
             + (" (a closed surface: cut its ends open)" if not loops else "")
+            + (" (side branches or holes: cut branches off and close holes)" if len(loops) > 2 else "")
         )
     return LumenSurface(path, points, triangles, loops)
 

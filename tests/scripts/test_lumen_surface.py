@@ -117,6 +117,10 @@ class LumenSurface(unittest.TestCase):
         with self.assertRaisesRegex(PatientInputError, r"\(2 boundary loops\), got 1"):
             read_lumen_surface(self.write(pts, tris, "one_end.stl"))
         pts, tris = tube()
+        hole = np.ones(len(tris), dtype=bool)
+        hole[2 * NC * (NA // 2) : 2 * NC * (NA // 2) + 6] = False  # a side hole: the stub of a branch
+        with self.assertRaisesRegex(PatientInputError, r"got 3 \(side branches or holes"):
+            read_lumen_surface(self.write(pts, tris[hole], "branch.stl"))
         extra = np.vstack([pts, [[0.0, 0.0, 50.0]]])
         fin = np.vstack([tris, [[tris[0][1], tris[0][2], len(pts)]]])  # a third triangle on an inner edge
         with self.assertRaisesRegex(PatientInputError, "more than two triangles"):
