@@ -95,6 +95,11 @@ class Study:
         self.plot = self._plot(doc.get("plot"))
         self.slurm = self._slurm(doc.get("slurm"))
         self.cases = self._expand(axes, listed, patients)
+        if self.plot and self.plot["x"] not in self.parameter_names():
+            raise StudyError(
+                f"{path}: plot: x: {self.plot['x']!r} is not a parameter of the study, expected one of "
+                + ", ".join(self.parameter_names())
+            )
 
     # -- sections --------------------------------------------------------------------------------
     def _grid(self, grid):

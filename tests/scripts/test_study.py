@@ -91,13 +91,14 @@ class Study(unittest.TestCase):
         self.refused(study_text(grid={"balloon.pressure.value": []}), "grid: balloon.pressure.value", "non-empty list")
         self.refused(study_text(grid={"baloon.pressure.value": [1.0]}), "baloon.pressure.value", "no map at 'baloon'")
         # a misspelt last key is caught by the solver's own key check of the case's scene
-        self.refused(study_text(grid={"balloon.pressure.valu": [1.0]}), "case 0", "valu")
+        self.refused(study_text(grid={"balloon.pressure.valu": [1.0]}, plot=None), "case 0", "valu")
         self.refused(study_text(grid={"balloon.pressure.value": [1.0, 1.0]}), "cases 0 and 1 are the same case")
         self.refused(
             study_text(grid=None, cases=[{"balloon.pressure.value": 1.0}, {"balloon.pressure.value": 1.0}]),
             "the same case",
         )
         self.refused(study_text(patients=["nope.csv"]), "patients[0]: nope.csv: no such file")
+        self.refused(study_text(plot={"x": "balloon.pressure"}), "plot: x: 'balloon.pressure' is not a parameter")
         self.refused(study_text(base="missing.yaml"), "base:")
         # a Slurm runner without sbatch: nothing submitted
         env = dict(os.environ, PATH="/nonexistent")
