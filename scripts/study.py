@@ -164,7 +164,7 @@ def main():
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("study", help="study file (YAML)")
     common.add_argument("--out-dir", help="output directory (default runs/studies/<name>)")
-    common.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
+    common.add_argument("--build-dir", default=os.environ.get("BUILD_DIR") or os.path.join(ROOT, "build"))
     r = sub.add_parser("run", parents=[common], help="run the study's unfinished cases")
     r.add_argument("--runner", choices=["local", "slurm"], default="local")
     r.add_argument("--jobs", type=int, help="local: cases at once (default: cores / (solid ranks + 1))")
