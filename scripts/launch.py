@@ -38,24 +38,15 @@ from pathlib import Path
 
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # the sibling tools, also under runpy
+import scene_keys  # noqa: E402
+
 ROOT = Path(__file__).resolve().parent.parent
 UNIX_PATH_MAX = 107
-# The top-level sections some executable reads (docs/user-guide.md "Scenes"). The launcher picks the processes
-# from these keys, so a misspelt one must stop the launch instead of silently running another
-# simulation (a scene without its `stent` runs the balloon alone).
-SECTIONS = (
-    "time",
-    "load_curves",
-    "output",
-    "stent",
-    "balloon",
-    "artery",
-    "solid",
-    "contact",
-    "coupling",
-    "patient",
-    "procedure",
-)
+# The top-level sections some executable reads (protocol/scene/keys.yaml). The launcher picks the
+# processes from these keys, so a misspelt one must stop the launch instead of silently running
+# another simulation (a scene without its `stent` runs the balloon alone).
+SECTIONS = tuple(scene_keys.children(""))
 # Catches typos (-n 2000 oversubscribes the machine into the ground) without limiting real runs.
 MAX_RANKS = 256
 # The run id is a chunk of the zenoh key expressions angio/<run_id>/...: '/' would shift the chunks

@@ -37,9 +37,11 @@ from pathlib import Path
 
 import yaml
 
+import scene_keys
+
 ROOT = Path(__file__).resolve().parent.parent
 LAUNCH = ROOT / "scripts" / "launch.py"
-PHASE_KEYS = ("name", "end", "steps", "balloon", "stent")
+PHASE_KEYS = tuple(scene_keys.children("procedure[0]"))
 NAME = re.compile(r"[A-Za-z0-9_-]{1,40}")
 STENT_CONTACTS = ("stent_balloon", "stent_artery")
 

@@ -42,6 +42,7 @@ import time
 
 import yaml
 
+from scene_keys import default
 from scene_variant import coupling_settings, launch_command, resolve_scene, variant_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -68,9 +69,9 @@ def _set_newton_tol(s, v):
     # The solid Newton stops at |r| <= atol or |r| <= rtol |r0| (solid_solver model.cpp), so rtol
     # alone does not move a scene whose atol is the looser criterion (the straight scene: rtol
     # 1e-4 ... 1e-10 gave identical results). Both are scaled together, atol keeping its ratio to
-    # rtol in the scene (1e-4 / 1e-8 by default).
+    # rtol in the scene (the declared defaults where it gives none).
     nw = s.setdefault("solid", {}).setdefault("newton", {})
-    ratio = nw.get("atol", 1e-4) / nw.get("rtol", 1e-8)
+    ratio = nw.get("atol", default("solid.newton.atol")) / nw.get("rtol", default("solid.newton.rtol"))
     nw["rtol"] = v
     nw["atol"] = v * ratio
 
@@ -83,10 +84,11 @@ def _set_mesh(s, f):
                 if k in m:
                     m[k] = max(3, int(round(m[k] * f)))
             for layer in m.get("layers", []):
-                layer["n_radial"] = max(1, int(round(layer.get("n_radial", 1) * f)))
+                n = layer.get("n_radial", default("artery.mesh.layers[0].n_radial"))
+                layer["n_radial"] = max(1, int(round(n * f)))
     pm = s.get("patient", {}).get("mesh")
     if isinstance(pm, dict):
-        pm["size"] = pm.get("size", 0.8) / f
+        pm["size"] = pm.get("size", default("patient.mesh.size")) / f
 
 
 def _set_beam(s, n):
@@ -111,7 +113,7 @@ def knobs(scene, quick, coupling):
         "newton_tol": (
             [1e-4, 1e-6, 1e-8, 1e-10],
             _set_newton_tol,
-            nw.get("rtol", 1e-8),
+            nw.get("rtol", default("solid.newton.rtol")),
             "solid Newton rtol (atol alike)",
             100.0,
         ),

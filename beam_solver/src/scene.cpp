@@ -22,24 +22,24 @@ Curve to_curve(const scene::LoadCurve& c) {
 
 Section read_section(const Node& st) {
   const Node mat = st.child("material", "a map {E, nu or G}");
-  mat.check_keys({"E", "nu", "G"});
-  const double E = mat.positive("E");
-  double nu = 0.3, G;
+  mat.check_keys();
+  const double E = mat.get<double>("E");
+  double nu, G;
   if (mat.has("G")) {
-    G = mat.positive("G");
+    G = mat.get<double>("G");
     nu = E / (2 * G) - 1;
   } else {
-    nu = mat.in_range("nu", -0.99, 0.4999);
+    nu = mat.get<double>("nu");
     G = E / (2 * (1 + nu));
   }
   const Node sec = st.child("section", "a map {radius} or {A, I2, I3, J}");
-  sec.check_keys({"radius", "A", "I2", "I3", "J", "shear_factors", "contact_radius"});
+  sec.check_keys();
   Section s;
   if (sec.has("radius")) {
-    const double R = sec.positive("radius");
+    const double R = sec.get<double>("radius");
     double k = -1;
     if (sec.has("shear_factors")) {
-      auto f = sec.numbers("shear_factors");
+      auto f = sec.get<std::vector<double>>("shear_factors");
       if (f.size() != 2 || !(f[0] > 0) || f[0] != f[1])
         sec.child("shear_factors").fail("two equal positive shear factors for a circular section");
       k = f[0];
@@ -48,20 +48,21 @@ Section read_section(const Node& st) {
   } else {
     double k2 = 1, k3 = 1;
     if (sec.has("shear_factors")) {
-      auto f = sec.numbers("shear_factors");
+      auto f = sec.get<std::vector<double>>("shear_factors");
       if (f.size() != 2 || !(f[0] > 0) || !(f[1] > 0))
         sec.child("shear_factors").fail("two positive shear factors [k2, k3]");
       k2 = f[0];
       k3 = f[1];
     }
-    s = general_section(E, G, sec.positive("A"), sec.positive("I2"), sec.positive("I3"), sec.positive("J"), k2, k3);
+    s = general_section(E, G, sec.get<double>("A"), sec.get<double>("I2"), sec.get<double>("I3"), sec.get<double>("J"),
+                        k2, k3);
   }
-  if (sec.has("contact_radius")) s.contact_radius = sec.positive("contact_radius");
+  if (sec.has("contact_radius")) s.contact_radius = sec.get<double>("contact_radius");
   if (auto pl = st.optional("plasticity")) {
-    pl->check_keys({"yield_moment", "tangent_modulus"});
+    pl->check_keys();
     if (std::abs(s.EI2 - s.EI3) > 1e-12 * s.EI2) pl->fail("a circular section (I2 == I3) for bending plasticity");
-    const double My0 = pl->positive("yield_moment");
-    const double Eep = pl->non_negative("tangent_modulus");
+    const double My0 = pl->get<double>("yield_moment");
+    const double Eep = pl->get<double>("tangent_modulus");
     if (!(Eep < E)) pl->child("tangent_modulus").fail("a value below E");
     add_bending_plasticity(s, E, My0, Eep);
   }
@@ -126,43 +127,38 @@ BeamScene beam_scene_from(const Node& root) {
   bs.output = scene::output_settings(root);
   const scene::LoadCurves curves = scene::load_curves(root);
   const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
-  st.check_keys({"material", "plasticity", "section", "generator", "nodes", "elements", "lines", "up", "axis",
-                 "fixation", "supports", "loads", "solver", "contact", "triads", "element", "initial_state"});
+  st.check_keys();
   bs.model = std::make_unique<BeamModel>();
   BeamModel& m = *bs.model;
   const int sec = m.add_section(read_section(st));
 
   // element: {residual: consistent | petrov_galerkin} (element.hpp, ResidualForm)
   if (auto el = st.optional("element")) {
-    el->check_keys({"residual"});
-    if (el->choice_or("residual", {"consistent", "petrov_galerkin"}, "consistent") == "petrov_galerkin")
-      m.residual_form = ResidualForm::petrov_galerkin;
+    el->check_keys();
+    if (el->get<std::string>("residual") == "petrov_galerkin") m.residual_form = ResidualForm::petrov_galerkin;
   }
 
   if (auto c = st.optional("contact")) {
-    c->check_keys({"points_per_element"});
-    m.sample_points_per_element = static_cast<int>(c->integer_or("points_per_element", 6, 1));
-    if (m.sample_points_per_element > 6) c->child("points_per_element").fail("an integer in 1..6");
+    c->check_keys();
+    m.sample_points_per_element = c->get<int>("points_per_element");
   }
 
   std::vector<int> fixation_default;
   if (auto g = st.optional("generator")) {
     if (st.has("nodes") || st.has("lines")) st.fail("either generator or nodes/elements/lines, not both");
-    g->check_keys({"type", "rings", "crowns", "crimped_diameter", "strut_height", "ring_pitch", "connectors",
-                   "elements_per_strut", "elements_per_connector", "centerline", "start"});
-    g->choice("type", {"corrugated_rings"});
+    g->check_keys();
+    g->get<std::string>("type");  // corrugated_rings, the one generator
     StentParameters p;
-    p.rings = static_cast<int>(g->integer_or("rings", p.rings, 1, 1000));  // 1000 rings: a 1.5 m stent
-    p.crowns = static_cast<int>(g->integer_or("crowns", p.crowns, 2, 1000));
-    p.crimped_diameter = g->positive_or("crimped_diameter", p.crimped_diameter);
-    p.strut_height = g->positive_or("strut_height", p.strut_height);
-    p.ring_pitch = g->positive_or("ring_pitch", p.ring_pitch);
-    p.connectors = static_cast<int>(g->integer_or("connectors", p.connectors, 0));
+    p.rings = g->get<int>("rings");  // at most 1000 rings, a 1.5 m stent
+    p.crowns = g->get<int>("crowns");
+    p.crimped_diameter = g->get<double>("crimped_diameter");
+    p.strut_height = g->get<double>("strut_height");
+    p.ring_pitch = g->get<double>("ring_pitch");
+    p.connectors = g->get<int>("connectors");
     if (p.connectors > p.crowns) g->child("connectors").fail("at most `crowns` connectors");
-    p.elements_per_strut = static_cast<int>(g->integer_or("elements_per_strut", p.elements_per_strut, 1, 100));
-    p.elements_per_connector =
-        static_cast<int>(g->integer_or("elements_per_connector", p.elements_per_connector, 1, 100));
-    p.start = g->number_or("start", -1);
+    p.elements_per_strut = g->get<int>("elements_per_strut");
+    p.elements_per_connector = g->get<int>("elements_per_connector");
+    p.start = g->get<double>("start");
     // centerline: {file} | {points}: the same key shape as balloon/artery.mesh.centerline, so
     // one centerline file places stent and balloon on the same curved axis (paper §2.4)
     std::optional<geometry::Centerline> cl;
@@ -181,7 +177,7 @@ BeamScene beam_scene_from(const Node& root) {
   } else if (auto ln = st.optional("lines")) {
     // straight lines subdivided into elements; coincident end points are merged
     Vec3 up = Vec3::Zero();
-    if (st.has("up")) up = v3(st.vec3("up"));
+    if (st.has("up")) up = v3(st.get<std::array<double, 3>>("up"));
     auto node_at = [&](const Vec3& x) {
       for (int i = 0; i < m.num_nodes(); ++i)
         if ((m.reference_position(i) - x).norm() < 1e-10) return i;
@@ -189,9 +185,9 @@ BeamScene beam_scene_from(const Node& root) {
     };
     for (std::size_t i = 0; i < ln->size(); ++i) {
       const Node l = ln->at(i);
-      l.check_keys({"from", "to", "elements"});
-      const Vec3 a = v3(l.vec3("from")), b = v3(l.vec3("to"));
-      const int n = static_cast<int>(l.integer("elements", 1));
+      l.check_keys();
+      const Vec3 a = v3(l.get<std::array<double, 3>>("from")), b = v3(l.get<std::array<double, 3>>("to"));
+      const int n = l.get<int>("elements");
       if ((b - a).norm() <= 0) l.fail("a line of non-zero length");
       int prev = node_at(a);
       for (int k = 1; k <= n; ++k) {
@@ -205,7 +201,7 @@ BeamScene beam_scene_from(const Node& root) {
     for (std::size_t i = 0; i < nodes.size(); ++i) m.add_node(v3(nodes.at(i).as_vec3()));
     const Node els = st.child("elements", "a list of [node1, node2]");
     Vec3 up = Vec3::Zero();
-    if (st.has("up")) up = v3(st.vec3("up"));
+    if (st.has("up")) up = v3(st.get<std::array<double, 3>>("up"));
     for (std::size_t i = 0; i < els.size(); ++i) {
       const auto ab = els.at(i).as_numbers();
       if (ab.size() != 2) els.at(i).fail("[node1, node2]");
@@ -222,7 +218,7 @@ BeamScene beam_scene_from(const Node& root) {
   const int ne = m.num_elements();
 
   if (auto ax = st.optional("axis")) {
-    ax->check_keys({"points"});
+    ax->check_keys();
     m.axis.points = read_points(ax->child("points", "a list of points [x, y, z]"));
   }
 
@@ -232,7 +228,7 @@ BeamScene beam_scene_from(const Node& root) {
   std::vector<int> ring_fixation;
   if (bs.stent) ring_fixation = bs.stent->ring_fixation_nodes;
   if (auto fx = st.optional("fixation")) {
-    fx->check_keys({"radial", "axial", "circumferential"});
+    fx->check_keys();
     for (const char* kind : {"radial", "axial", "circumferential"}) {
       if (!fx->has(kind)) continue;
       const Node r = fx->child(kind);
@@ -262,7 +258,7 @@ BeamScene beam_scene_from(const Node& root) {
   if (auto sup = st.optional("supports")) {
     for (std::size_t i = 0; i < sup->size(); ++i) {
       const Node s = sup->at(i);
-      s.check_keys({"nodes", "fix", "displacement", "rotation", "curve"});
+      s.check_keys();
       const auto nodes = node_list(s, "nodes", nn);
       std::array<bool, 6> f{};
       const Node fix = s.child("fix", "'all' or a list of x, y, z, rx, ry, rz");
@@ -284,7 +280,7 @@ BeamScene beam_scene_from(const Node& root) {
       for (int n : nodes) {
         m.fix(n, f);
         if (s.has("displacement")) {
-          const Vec3 u = v3(s.vec3("displacement"));
+          const Vec3 u = v3(s.get<std::array<double, 3>>("displacement"));
           for (int k = 0; k < 3; ++k)
             if (u(k) != 0.0) {
               if (!f[k]) s.child("displacement").fail("non-zero values only on fixed directions");
@@ -293,7 +289,7 @@ BeamScene beam_scene_from(const Node& root) {
         }
         if (s.has("rotation")) {
           if (!(f[3] && f[4] && f[5])) s.child("rotation").fail("rx, ry and rz all fixed for a prescribed rotation");
-          m.prescribed_rotations.push_back({n, v3(s.vec3("rotation")), c});
+          m.prescribed_rotations.push_back({n, v3(s.get<std::array<double, 3>>("rotation")), c});
         }
       }
     }
@@ -302,34 +298,33 @@ BeamScene beam_scene_from(const Node& root) {
   if (auto loads = st.optional("loads")) {
     for (std::size_t i = 0; i < loads->size(); ++i) {
       const Node l = loads->at(i);
-      const std::string type = l.choice("type", {"nodal", "line", "radial_line"});
+      const std::string type = l.get<std::string>("type");
       const Curve c = to_curve(scene::curve_ref(l, "curve", curves));
       if (type == "nodal") {
         l.check_keys({"type", "nodes", "force", "moment", "curve"});
         Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-        if (l.has("force")) F = v3(l.vec3("force"));
-        if (l.has("moment")) M = v3(l.vec3("moment"));
+        if (l.has("force")) F = v3(l.get<std::array<double, 3>>("force"));
+        if (l.has("moment")) M = v3(l.get<std::array<double, 3>>("moment"));
         for (int n : node_list(l, "nodes", nn)) m.nodal_loads.push_back({n, F, M, c});
       } else if (type == "line") {
         l.check_keys({"type", "elements", "q", "curve"});
-        m.line_loads.push_back({element_list(l, "elements", ne), v3(l.vec3("q")), c});
+        m.line_loads.push_back({element_list(l, "elements", ne), v3(l.get<std::array<double, 3>>("q")), c});
       } else {
         l.check_keys({"type", "elements", "magnitude", "curve", "follower"});
         m.radial_loads.push_back(
-            {element_list(l, "elements", ne), l.number("magnitude"), c, l.boolean_or("follower", false)});
+            {element_list(l, "elements", ne), l.get<double>("magnitude"), c, l.get<bool>("follower")});
       }
     }
   }
 
   if (auto so = st.optional("solver")) {
-    so->check_keys(
-        {"linear_solver", "max_iterations", "residual_tol", "residual_rel_tol", "increment_tol", "line_search"});
-    m.newton.linear_solver = so->choice_or("linear_solver", {"umfpack", "klu", "sparselu"}, "klu");
-    m.newton.max_iterations = static_cast<int>(so->integer_or("max_iterations", 30, 1));
-    m.newton.residual_tol = so->positive_or("residual_tol", m.newton.residual_tol);
-    m.newton.residual_rel_tol = so->non_negative_or("residual_rel_tol", m.newton.residual_rel_tol);
-    m.newton.increment_tol = so->positive_or("increment_tol", m.newton.increment_tol);
-    m.newton.line_search = so->boolean_or("line_search", false);
+    so->check_keys();
+    m.newton.linear_solver = so->get<std::string>("linear_solver");
+    m.newton.max_iterations = so->get<int>("max_iterations");
+    m.newton.residual_tol = so->get<double>("residual_tol");
+    m.newton.residual_rel_tol = so->get<double>("residual_rel_tol");
+    m.newton.increment_tol = so->get<double>("increment_tol");
+    m.newton.line_search = so->get<bool>("line_search");
   }
   try {
     m.finalize();
@@ -337,7 +332,7 @@ BeamScene beam_scene_from(const Node& root) {
     st.fail(std::string("a consistent model (") + e.what() + ")");
   }
   if (auto is = st.optional("initial_state")) {  // continue from an earlier run's committed stent
-    is->check_keys({"file"});
+    is->check_keys();
     const Node file = is->child("file", "the path of a beam state file (<run>/beam/state.h5 of an earlier run)");
     try {
       bs.initial_state = read_beam_state(scene::resolve_path(*is, file.as_string()));

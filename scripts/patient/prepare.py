@@ -11,7 +11,6 @@ the run directory. A placement.json records what was done (spline knots, eq. (3)
   /usr/bin/python3 -m patient.prepare SCENE OUT_DIR     (from scripts/; the launcher calls prepare_scene)
 """
 import copy
-import difflib
 import json
 import math
 import shutil
@@ -19,87 +18,24 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import scene_keys
 
 from .artery_mesh import WallSpec, build_artery, layer_radii
 from .centerline_csv import read_centerline_csv, write_centerline_csv
 from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
-from .lumen_surface import UNITS, read_lumen_surface
+from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 
-# key: (kind, default); kind is the expected type; None default = required
-KEYS = {
-    # exactly one of: a lumen centerline CSV, or a lumen surface (its centerline computed, lumen_centerline.py)
-    "centerline": ("path", ""),
-    "lumen_surface": ("map", {}),
-    "stenosis": ("auto_or_number", "auto"),
-    "wall": ("map", {}),
-    "mesh": ("map", {}),
-    "balloon_spline": ("map", {}),
-    "insertion": ("map", {}),
-}
-WALL_KEYS = {
-    "thickness": ("from_centerline_or_number", "from_centerline"),
-    # thickness / outer diameter; see docs/user-guide.md "Patient-specific arteries" for the source
-    "media_ratio": ("fraction", 0.06),
-    "adventitia_ratio": ("fraction", 0.065),
-    "min_intima": ("positive", 0.05),
-}
-SURFACE_KEYS = {"file": ("path", None), "units": ("units", "mm"), "spacing": ("positive", 0.2)}
-MESH_KEYS = {"size": ("positive", 0.8), "binary": ("bool", True), "loft_spacing": ("positive", 0.5)}
-SPLINE_KEYS = {"smoothing": ("positive", 4.0), "clearance": ("non_negative", 0.0)}
+# The keys of `patient:` (their types, defaults and ranges) are declared in protocol/scene/keys.yaml
+# and checked by scene_keys.check_map.
 # A lesion narrower than a crimped device: a rigid capsule along the balloon axis (contact.insertion)
 # opens the lumen to the devices' outer radius plus `clearance` during the blood-pressure phase, the
 # stent- and balloon-artery contacts switch on once it is open, and it retracts by t = 0 so that the
 # wall comes to rest on the devices (as catheter insertion is modelled by Zahedmanesh, Kelly and Lally,
 # J Biomech 43 (2010) 2126, and Mortier et al., Ann Biomed Eng 38 (2010) 88). clearance 0.065 mm and
-# penalty 300 N/mm^3: configs/stability/severe_stenosis_insertion.yaml, which runs with them.
-INSERTION_KEYS = {"mode": ("auto_or_off", "auto"), "clearance": ("positive", 0.065), "penalty": ("positive", 300.0)}
+# penalty 300 N/mm^3 (patient.insertion): configs/stability/severe_stenosis_insertion.yaml runs with them.
 INSERTION_CURVE = "insertion_tool"
-
-
-def _check_map(value, spec, where, scene_path):
-    if not isinstance(value, dict):
-        raise PatientInputError(f"{scene_path}: {where}: expected a map of keys ({', '.join(spec)}), got {value!r}")
-    out = {}
-    for k in value:
-        if k not in spec:
-            near = difflib.get_close_matches(str(k), list(spec), n=1)
-            hint = f"; did you mean `{near[0]}`?" if near else ""
-            raise PatientInputError(f"{scene_path}: {where}.{k}: unknown key, expected one of {', '.join(spec)}{hint}")
-    for k, (kind, default) in spec.items():
-        if k not in value:
-            if default is None:
-                raise PatientInputError(f"{scene_path}: {where}.{k}: missing, expected {kind.replace('_', ' ')}")
-            out[k] = default
-            continue
-        v = value[k]
-        bad = None
-        num = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-        if kind == "positive" and not (num and v > 0):
-            bad = "a positive number"
-        elif kind == "non_negative" and not (num and v >= 0):
-            bad = "a number >= 0"
-        elif kind == "fraction" and not (num and 0 < v < 0.5):
-            bad = "a ratio between 0 and 0.5"
-        elif kind == "bool" and not isinstance(v, bool):
-            bad = "true or false"
-        elif kind == "path" and not (isinstance(v, str) and v):
-            bad = "a file path"
-        elif kind == "auto_or_number" and not (v == "auto" or (num and v >= 0)):
-            bad = "auto or an arc length >= 0 (mm)"
-        elif kind == "from_centerline_or_number" and not (v == "from_centerline" or (num and v > 0)):
-            bad = "from_centerline (the CSV's wall column) or a positive thickness (mm)"
-        elif kind == "auto_or_off" and v not in ("auto", "off"):
-            bad = "auto (open a lesion narrower than the devices with the virtual insertion tool) or off"
-        elif kind == "map" and not isinstance(v, dict):
-            bad = "a map"
-        elif kind == "units" and v not in UNITS:
-            bad = "a length unit, one of " + ", ".join(UNITS)
-        if bad:
-            raise PatientInputError(f"{scene_path}: {where}.{k}: expected {bad}, got {v!r}")
-        out[k] = v
-    return out
 
 
 def _section(scene, path, scene_path, what):
@@ -145,15 +81,21 @@ def device_of(scene, scene_path):
                 f"{scene_path}: stent.generator.{k}: expected none with a `patient:` section "
                 f"(the stent is placed at the stenosis on the balloon centerline)"
             )
-    # the generator's defaults (beam_solver StentParameters) for keys the scene leaves out
-    rings = g.get("rings", 6)
-    pitch = g.get("ring_pitch", 1.5)
-    height = g.get("strut_height", 1.5)
-    crimped = g.get("crimped_diameter", 1.15)
-    sec = scene.get("stent", {}).get("section", {}).get("radius", 0.06)
+    # the generator's declared defaults for the keys the scene leaves out
+    rings, pitch, height, crimped = (
+        g.get(k, scene_keys.default(f"stent.generator.{k}"))
+        for k in ("rings", "ring_pitch", "strut_height", "crimped_diameter")
+    )
     for k, v in (("rings", rings), ("ring_pitch", pitch), ("strut_height", height), ("crimped_diameter", crimped)):
         if not (isinstance(v, (int, float)) and not isinstance(v, bool) and v > 0):
             raise PatientInputError(f"{scene_path}: stent.generator.{k}: expected a positive number, got {v!r}")
+    section = (scene.get("stent") or {}).get("section") or {}
+    sec = section.get("contact_radius", section.get("radius"))
+    if not (isinstance(sec, (int, float)) and not isinstance(sec, bool) and sec > 0):
+        raise PatientInputError(
+            f"{scene_path}: stent.section.radius: expected a positive number (mm), the strut radius that sizes "
+            f"the crimped stent (or stent.section.contact_radius), got {sec!r}"
+        )
     stent_length = (rings - 1) * pitch + height
     return Device(
         balloon_length=float(bm["length"]),
@@ -242,7 +184,7 @@ def lumen_csv(pat, scene_path, out_dir, log):
         )
     if pat["centerline"]:
         return (scene_path.parent / pat["centerline"]).resolve()
-    spec = _check_map(pat["lumen_surface"], SURFACE_KEYS, "patient.lumen_surface", scene_path)
+    spec = scene_keys.check_map(pat["lumen_surface"], "patient.lumen_surface", scene_path, PatientInputError)
     path = (scene_path.parent / spec["file"]).resolve()
     surface = read_lumen_surface(str(path), spec["units"])
     points, radius = lumen_centerline(surface, spacing=spec["spacing"])
@@ -257,11 +199,11 @@ def lumen_csv(pat, scene_path, out_dir, log):
 def prepare_scene(scene, scene_path, out_dir, log=print):
     """The completed scene (a new dict) with its generated files in out_dir; PatientInputError on bad input."""
     scene_path = Path(scene_path)
-    pat = _check_map(scene.get("patient"), KEYS, "patient", scene_path)
-    wall = _check_map(pat["wall"], WALL_KEYS, "patient.wall", scene_path)
-    mesh = _check_map(pat["mesh"], MESH_KEYS, "patient.mesh", scene_path)
-    spl = _check_map(pat["balloon_spline"], SPLINE_KEYS, "patient.balloon_spline", scene_path)
-    ins = _check_map(pat["insertion"], INSERTION_KEYS, "patient.insertion", scene_path)
+    pat = scene_keys.check_map(scene.get("patient"), "patient", scene_path, PatientInputError)
+    wall, mesh, spl, ins = (
+        scene_keys.check_map(pat[k] or {}, f"patient.{k}", scene_path, PatientInputError)
+        for k in ("wall", "mesh", "balloon_spline", "insertion")
+    )
     artery = _section(scene, ["artery"], scene_path, "an artery section {layers, blood_pressure, ...}")
     if not isinstance(artery, dict):
         raise PatientInputError(f"{scene_path}: artery: expected a map, got {artery!r}")

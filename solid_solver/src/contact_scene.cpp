@@ -23,21 +23,21 @@ bool disabled(const Node& n) {
 // `from` (s): the pair is off before this pseudo-time; absent: always on.
 double read_from(const Node& n) {
   if (!n.has("from")) return kAlwaysActive;
-  return n.number("from");
+  return n.get<double>("from");
 }
 
 std::optional<double> read_line_pair(const Node& c, const std::string& key, std::optional<double> def, double& from) {
   const auto n = c.optional(key);
   if (!n) return def;
   if (disabled(*n)) return std::nullopt;
-  n->check_keys({"penalty", "from"});
+  n->check_keys();
   from = read_from(*n);
-  return n->positive_or("penalty", def.value_or(contact::kLinePenaltyDefault));
+  return n->get<double>("penalty");
 }
 
 // contact.insertion: the virtual insertion tool (insertion_tool.hpp).
 ContactSpec::Insertion read_insertion(const Node& n, const Node& root) {
-  n.check_keys({"axis", "radius", "penalty"});
+  n.check_keys();
   ContactSpec::Insertion ins;
   const char* what = "'balloon' (its axis from end to end) or a polyline of at least 2 points [[x, y, z], ...] (mm)";
   const Node axis = n.child("axis", what);
@@ -62,7 +62,7 @@ ContactSpec::Insertion read_insertion(const Node& n, const Node& root) {
   const auto [low, peak] = ins.radius.range();
   if (!(peak > 0.0) || low < 0.0 || peak > 50.0)
     n.child("radius").fail("a radius (value x load curve) between 0 and 50 mm, positive somewhere");
-  ins.penalty = n.positive_or("penalty", ins.penalty);
+  ins.penalty = n.get<double>("penalty");
   return ins;
 }
 }  // namespace
@@ -77,15 +77,13 @@ ContactSpec read_contact_spec(const Node& root) {
     spec.balloon_artery.reset();
     return spec;
   }
-  c->check_keys({"stent_balloon", "stent_artery", "balloon_artery", "search_radius", "line_regularization",
-                 "line_normals", "log", "insertion"});
-  spec.search_radius = c->positive_or("search_radius", spec.search_radius);
-  spec.line_regularization = c->non_negative_or("line_regularization", spec.line_regularization);
+  c->check_keys();
+  spec.search_radius = c->get<double>("search_radius");
+  spec.line_regularization = c->get<double>("line_regularization");
   if (!(spec.line_regularization < 0.5 * spec.search_radius))
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
-  spec.line_averaged_normals =
-      c->choice_or("line_normals", {"closest_point", "averaged"}, "closest_point") == "averaged";
-  spec.log = c->boolean_or("log", spec.log);
+  spec.line_averaged_normals = c->get<std::string>("line_normals") == "averaged";
+  spec.log = c->get<bool>("log");
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);
   if (const auto n = c->optional("insertion")) {
@@ -97,19 +95,18 @@ ContactSpec read_contact_spec(const Node& root) {
     if (disabled(*n)) {
       spec.balloon_artery.reset();
     } else {
-      n->check_keys({"penalty", "quadrature", "regularization", "two_pass", "slave", "from"});
+      n->check_keys();
       auto& o = *spec.balloon_artery;
       o.from = read_from(*n);
-      o.penalty = n->positive_or("penalty", o.penalty);
-      o.quadrature = int(n->integer_or("quadrature", o.quadrature, 1));
-      if (o.quadrature > 7) n->child("quadrature").fail("a quadrature degree between 1 and 7");
-      o.two_pass = n->boolean_or("two_pass", o.two_pass);
-      o.regularization = n->non_negative_or("regularization", o.regularization);
+      o.penalty = n->get<double>("penalty");
+      o.quadrature = n->get<int>("quadrature");
+      o.two_pass = n->get<bool>("two_pass");
+      o.regularization = n->get<double>("regularization");
       // The side whose Gauss points are projected: seen from the balloon, the lumen is a concave
       // faceted surface, and the closest face (and with it the contact normal) jumps at the bisector
       // of two faces; seen from the lumen, the balloon is convex and the closest point moves
       // continuously over its edges.
-      if (n->choice_or("slave", {"balloon", "artery"}, "balloon") == "artery") std::swap(o.slave, o.master);
+      if (n->get<std::string>("slave") == "artery") std::swap(o.slave, o.master);
       if (!(o.regularization < 0.5 * spec.search_radius))
         n->child("regularization").fail("a value below half of contact.search_radius (mm)");
     }

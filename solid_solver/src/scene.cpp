@@ -18,34 +18,31 @@ using scene::Node;
 Vec3d v3(const std::array<double, 3>& a) { return Vec3d(a[0], a[1], a[2]); }
 
 LayerMaterial read_material(const Node& n, const std::string& name) {
-  n.check_keys({"E", "nu", "fibers", "viscous"});
+  n.check_keys();
   LayerMaterial m;
   m.name = name;
-  m.matrix.E = n.positive("E");
-  m.matrix.nu = n.number_or("nu", 0.0);
-  if (!(m.matrix.nu >= 0.0 && m.matrix.nu < 0.5)) n.child("nu").fail("a Poisson's ratio in [0, 0.5)");
+  m.matrix.E = n.get<double>("E");
+  m.matrix.nu = n.get<double>("nu");
   if (auto v = n.optional("viscous")) {  // paper eqs. B.5–B.8: Q' + Q/tau = beta S'
-    v->check_keys({"tau", "beta", "acts_on"});
+    v->check_keys();
     ViscousBranch vb;
-    vb.tau = v->positive("tau");
-    vb.beta = v->non_negative("beta");
+    vb.tau = v->get<double>("tau");
+    vb.beta = v->get<double>("beta");
     // which part of S∞ relaxes: the Neo-Hooke matrix (4C's VISCO_GenMax, the default) or all of it
-    vb.acts_on = v->choice_or("acts_on", {"isotropic", "all"}, to_string(kViscousActsOnDefault)) == "isotropic"
-                     ? ViscousActsOn::isotropic
-                     : ViscousActsOn::all;
+    vb.acts_on = v->get<std::string>("acts_on") == "isotropic" ? ViscousActsOn::isotropic : ViscousActsOn::all;
     m.viscous = vb;
   }
   if (auto f = n.optional("fibers")) {
     if (!f->is_sequence()) f->fail("a list of fiber families {k1, k2, angle, pair, tension_only}");
     for (size_t i = 0; i < f->size(); ++i) {
       const Node fi = f->at(i);
-      fi.check_keys({"k1", "k2", "angle", "pair", "tension_only"});
+      fi.check_keys();
       FiberSpec s;
-      s.k1 = fi.non_negative("k1");
-      s.k2 = fi.positive("k2");
-      s.angle_deg = fi.in_range("angle", -90.0, 90.0);
-      s.pair = fi.boolean_or("pair", false);
-      s.tension_only = fi.boolean_or("tension_only", true);
+      s.k1 = fi.get<double>("k1");
+      s.k2 = fi.get<double>("k2");
+      s.angle_deg = fi.get<double>("angle");
+      s.pair = fi.get<bool>("pair");
+      s.tension_only = fi.get<bool>("tension_only");
       m.fibers.push_back(s);
     }
   }
@@ -55,10 +52,10 @@ LayerMaterial read_material(const Node& n, const std::string& name) {
 Axis read_axis(const Node& parent, const Vec3d& default_origin) {
   Axis a{default_origin, Vec3d::UnitZ()};
   if (auto n = parent.optional("axis")) {
-    n->check_keys({"origin", "direction"});
-    if (n->has("origin")) a.origin = v3(n->vec3("origin"));
+    n->check_keys();
+    if (n->has("origin")) a.origin = v3(n->get<std::array<double, 3>>("origin"));
     if (n->has("direction")) {
-      a.direction = v3(n->vec3("direction"));
+      a.direction = v3(n->get<std::array<double, 3>>("direction"));
       if (a.direction.norm() < 1e-12) n->child("direction").fail("a non-zero vector");
       a.direction.normalize();
     }
@@ -104,10 +101,10 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   const std::string prefix = part + "_";
   if (mesh.has("file")) {
     mesh.check_keys({"file", "scale", "inner", "outer", "ends", "axis", "centerline"});
-    const std::string path = scene::resolve_path(mesh, mesh.string("file"));
+    const std::string path = scene::resolve_path(mesh, mesh.get<std::string>("file"));
     Mesh m;
     try {
-      m = read_gmsh(path, part, prefix, mesh.positive_or("scale", 1.0));
+      m = read_gmsh(path, part, prefix, mesh.get<double>("scale"));
     } catch (const std::exception& e) {
       mesh.child("file").fail(std::string("a readable gmsh 4.1 mesh, ASCII or binary (") + e.what() + ")");
     }
@@ -131,7 +128,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     length = smax - smin;
     // rename the named surfaces to the canonical names used by the loads
     auto rename = [&](const std::string& key, const std::string& canonical) {
-      const std::string given = prefix + mesh.string(key);
+      const std::string given = prefix + mesh.get<std::string>(key);
       for (auto& s : m.surfaces)
         if (s.name == given) {
           s.name = canonical;
@@ -169,15 +166,15 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
                                                            "center", "layers", "centerline", "start", "stenosis"}
                       : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall", "n_circ",
                                                            "n_axial", "center", "centerline", "start"});
-  mesh.choice("generator", {"tube"});
+  if (mesh.get<std::string>("generator") != "tube") mesh.child("generator").fail("tube");
   TubeSpec t;
   t.part = part;
   t.surface_prefix = prefix;
-  t.length = mesh.positive("length");
-  const double ro = 0.5 * mesh.positive("outer_diameter");
-  t.n_circ = int(mesh.integer("n_circ", 3, 100000));
-  t.n_axial = int(mesh.integer("n_axial", 1, 1000000));
-  if (mesh.has("center")) t.center = v3(mesh.vec3("center"));
+  t.length = mesh.get<double>("length");
+  const double ro = 0.5 * mesh.get<double>("outer_diameter");
+  t.n_circ = mesh.get<int>("n_circ");
+  t.n_axial = mesh.get<int>("n_axial");
+  if (mesh.has("center")) t.center = v3(mesh.get<std::array<double, 3>>("center"));
   double wall = 0.0;
   if (layered) {
     const Node layers = mesh.child("layers", "a list of layers {name, thickness, n_radial} from inside out");
@@ -185,26 +182,26 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
       layers.fail("a non-empty list of layers {name, thickness, n_radial}");
     for (size_t i = 0; i < layers.size(); ++i) {
       const Node l = layers.at(i);
-      l.check_keys({"name", "thickness", "n_radial"});
+      l.check_keys();
       TubeLayer tl;
-      tl.name = l.string("name");
-      tl.thickness = l.positive("thickness");
-      tl.n_radial = int(l.integer_or("n_radial", 1, 1, 10000));
+      tl.name = l.get<std::string>("name");
+      tl.thickness = l.get<double>("thickness");
+      tl.n_radial = l.get<int>("n_radial");
       wall += tl.thickness;
       t.layers.push_back(tl);
     }
   } else {
-    wall = mesh.positive("wall");
+    wall = mesh.get<double>("wall");
     t.layers = {{part, wall, 1}};
   }
   t.inner_radius = ro - wall;
   if (!(t.inner_radius > 0))
     mesh.child("outer_diameter").fail("an outer diameter larger than twice the wall thickness");
   if (auto st = mesh.optional("stenosis")) {  // idealized concentric stenosis (mesh.hpp, TubeStenosis)
-    st->check_keys({"severity", "length", "position"});
-    t.stenosis.severity = st->in_range("severity", 0.0, 0.9);  // diameter stenosis; 90 % leaves a 10 % lumen
-    t.stenosis.length = st->positive("length");
-    t.stenosis.position = st->number_or("position", 0.0);
+    st->check_keys();
+    t.stenosis.severity = st->get<double>("severity");  // diameter stenosis; 90 % leaves a 10 % lumen
+    t.stenosis.length = st->get<double>("length");
+    t.stenosis.position = st->get<double>("position");
     if (std::abs(t.stenosis.position) + 0.5 * t.stenosis.length > 0.5 * t.length)
       st->child("length").fail(
           "a stenosis within the tube (|position| + length/2 <= " + std::to_string(0.5 * t.length) + " mm)");
@@ -214,9 +211,9 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     if (mesh.has("center"))
       mesh.child("center").fail("no 'center' with a 'centerline' (a curved tube is placed by centerline and start)");
     geometry::Centerline c = geometry::centerline_from_scene(*cl);
-    const std::string source = cl->is_map() && cl->has("file") ? cl->string("file") : "the given points";
+    const std::string source = cl->is_map() && cl->has("file") ? cl->get<std::string>("file") : "the given points";
     if (mesh.has("start")) {
-      t.start = mesh.non_negative("start");
+      t.start = mesh.get<double>("start");
       if (t.start + t.length > c.length() + 1e-9)
         mesh.child("start").fail("a start arc length with start + length (" + std::to_string(t.start + t.length) +
                                  " mm) within the centerline (" + source + ", " + std::to_string(c.length()) +
@@ -272,9 +269,9 @@ void read_fixed(const Node& part, const std::string& prefix, const Mesh& m, std:
   if (!f->is_sequence()) f->fail("a list of {surface, components}");
   for (size_t i = 0; i < f->size(); ++i) {
     const Node e = f->at(i);
-    e.check_keys({"surface", "components"});
+    e.check_keys();
     FixedSpec fs;
-    fs.surface = prefix + e.string("surface");
+    fs.surface = prefix + e.get<std::string>("surface");
     if (!m.surface(fs.surface)) e.child("surface").fail("a surface set of this part (e.g. inner, outer, end0, end1)");
     if (e.has("components")) {
       const Node c = e.child("components");
@@ -293,7 +290,7 @@ void read_fixed(const Node& part, const std::string& prefix, const Mesh& m, std:
 
 // solid.initial_state: {file, parts}: the parts' committed state from a state file of an earlier run.
 void read_initial_state(const Node& is, const Node& root, SolidScene& sc) {
-  is.check_keys({"file", "parts"});
+  is.check_keys();
   const Node file = is.child("file", "the path of a solid state file (<run>/solid/state.h5 of an earlier run)");
   const std::string path = scene::resolve_path(is, file.as_string());
   StateFile state;
@@ -333,7 +330,7 @@ SolidScene read_solid_scene(const Node& root) {
 
   if (auto b = root.optional("balloon")) {
     sc.has_balloon = true;
-    b->check_keys({"mesh", "material", "pressure", "end_springs", "summary", "fixed"});
+    b->check_keys();
     Axis axis;
     std::vector<std::string> req;
     double length = 0;
@@ -353,7 +350,7 @@ SolidScene read_solid_scene(const Node& root) {
       sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure",
                                            kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
     if (b->has("end_springs")) {
-      const double k = b->positive("end_springs");
+      const double k = b->get<double>("end_springs");
       for (const char* s : {"balloon_end0", "balloon_end1"}) {
         if (!m.surface(s)) b->child("end_springs").fail("balloon end surfaces (mesh.ends) for the springs");
         sc.springs.push_back({s, k});
@@ -372,8 +369,8 @@ SolidScene read_solid_scene(const Node& root) {
       }
       double end_offset = std::min(1.7, 0.25 * (smax - smin));
       if (auto s = b->optional("summary")) {
-        s->check_keys({"end_offset"});
-        end_offset = s->non_negative_or("end_offset", end_offset);
+        s->check_keys();
+        if (s->has("end_offset")) end_offset = s->get<double>("end_offset");
         if (!(2 * end_offset < smax - smin))
           s->child("end_offset").fail("an offset smaller than half the balloon length");
       }
@@ -393,7 +390,7 @@ SolidScene read_solid_scene(const Node& root) {
 
   if (auto a = root.optional("artery")) {
     sc.has_artery = true;
-    a->check_keys({"mesh", "layers", "blood_pressure", "end_springs", "fixed", "summary"});
+    a->check_keys();
     Axis axis;
     std::vector<std::string> req;
     double length = 0;
@@ -412,7 +409,7 @@ SolidScene read_solid_scene(const Node& root) {
       sc.pressures.push_back(
           read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure", kMaxBloodPressure, "300 mmHg"));
     if (a->has("end_springs")) {
-      const double k = a->positive("end_springs");
+      const double k = a->get<double>("end_springs");
       for (const char* s : {"artery_end0", "artery_end1"}) {
         if (!m.surface(s)) a->child("end_springs").fail("artery end surfaces (mesh.ends) for the springs");
         sc.springs.push_back({s, k});
@@ -427,11 +424,9 @@ SolidScene read_solid_scene(const Node& root) {
       sc.lumen = d;
     }
     if (auto s = a->optional("summary")) {
-      s->check_keys({"apposition_threshold", "lumen_stations"});
-      sc.apposition_threshold = s->non_negative_or("apposition_threshold", sc.apposition_threshold);
-      const long n = s->integer_or("lumen_stations", sc.lumen_max_stations, 2);
-      if (n > 10000) s->child("lumen_stations").fail("at most 10000 lumen stations");
-      sc.lumen_max_stations = int(n);
+      s->check_keys();
+      sc.apposition_threshold = s->get<double>("apposition_threshold");
+      sc.lumen_max_stations = s->get<int>("lumen_stations");
     }
     sc.mesh.append(m);
   }
@@ -443,23 +438,20 @@ SolidScene read_solid_scene(const Node& root) {
         root.fail("unique block names (balloon and artery both have a block '" + sc.mesh.blocks[i].name + "')");
 
   if (auto s = root.optional("solid")) {
-    s->check_keys({"ranks", "partitioner", "petsc_options", "newton", "initial_state"});
-    sc.ranks = int(s->integer_or("ranks", 0, 1));
-    sc.options.partitioner =
-        s->choice_or("partitioner", {"contiguous", "ptscotch", "parmetis", "average", "square"}, "contiguous");
-    sc.options.petsc_options = s->string_or("petsc_options", "");
+    s->check_keys();
+    sc.ranks = s->has("ranks") ? s->get<int>("ranks") : 0;
+    sc.options.partitioner = s->get<std::string>("partitioner");
+    sc.options.petsc_options = s->get<std::string>("petsc_options");
     if (auto n = s->optional("newton")) {
-      n->check_keys({"max_iterations", "rtol", "atol", "line_search", "max_line_search", "verbose", "damping",
-                     "damping_parts", "reuse_preconditioner", "tangent", "max_contraction", "continuation",
-                     "prediction"});
+      n->check_keys();
       auto& no = sc.options.newton;
-      no.max_iterations = int(n->integer_or("max_iterations", no.max_iterations, 1));
-      no.rtol = n->positive_or("rtol", no.rtol);
-      no.atol = n->positive_or("atol", no.atol);
-      no.line_search = n->boolean_or("line_search", no.line_search);
-      no.max_line_search = int(n->integer_or("max_line_search", no.max_line_search, 0));
-      no.verbose = n->boolean_or("verbose", no.verbose);
-      no.damping = n->non_negative_or("damping", no.damping);
+      no.max_iterations = n->get<int>("max_iterations");
+      no.rtol = n->get<double>("rtol");
+      no.atol = n->get<double>("atol");
+      no.line_search = n->get<bool>("line_search");
+      no.max_line_search = n->get<int>("max_line_search");
+      no.verbose = n->get<bool>("verbose");
+      no.damping = n->get<double>("damping");
       if (auto dp = n->optional("damping_parts")) {
         if (!(no.damping > 0)) dp->fail("no damping_parts without damping > 0");
         if (!dp->is_sequence() || dp->size() == 0) dp->fail("a list of parts out of balloon, artery");
@@ -471,19 +463,13 @@ SolidScene read_solid_scene(const Node& root) {
           no.damping_parts.push_back(part);
         }
       }
-      const long lag = n->integer_or("reuse_preconditioner", no.reuse_preconditioner, 0);
-      if (lag > 1000) n->child("reuse_preconditioner").fail("at most 1000 Krylov iterations per reused preconditioner");
-      no.reuse_preconditioner = int(lag);
-      no.modified = n->choice_or("tangent", {"exact", "modified"}, "exact") == "modified";
-      no.max_contraction = n->positive_or("max_contraction", no.max_contraction);
-      const long cont = n->integer_or("continuation", no.continuation, 0, 1024);
-      if (cont == 1)
+      no.reuse_preconditioner = n->get<int>("reuse_preconditioner");
+      no.modified = n->get<std::string>("tangent") == "modified";
+      no.max_contraction = n->get<double>("max_contraction");
+      no.continuation = n->get<int>("continuation");
+      if (no.continuation == 1)
         n->child("continuation").fail("0 (off) or the finest sub-increment as a fraction 1/N, N from 2 to 1024");
-      no.continuation = int(cont);
-      no.extrapolate = n->choice_or("prediction", {"constant", "extrapolate"},
-                                    no.extrapolate ? "extrapolate" : "constant") == "extrapolate";
-      if (!(no.max_contraction < 1.0))
-        n->child("max_contraction").fail("a contraction factor between 0 and 1 (exclusive)");
+      no.extrapolate = n->get<std::string>("prediction") == "extrapolate";
       if (n->optional("max_contraction") && !no.modified)
         n->child("max_contraction")
             .fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");

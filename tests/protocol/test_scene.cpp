@@ -34,12 +34,47 @@ void expect_error(F f, std::initializer_list<std::string> fragments) {
 
 TEST(Scene, ReadsValuesWithPaths) {
   Node root = load_scene(kGood);
-  EXPECT_DOUBLE_EQ(root.child("stent").child("material").positive("E"), 380000.0);
+  EXPECT_DOUBLE_EQ(root.child("stent").child("material").number("E"), 380000.0);
   EXPECT_EQ(root.child("stent").integer("rings", 1), 4);
   auto c = root.child("stent").vec3("center");
   EXPECT_DOUBLE_EQ(c[2], 1.5);
   EXPECT_EQ(root.child("stent").child("material").path(), "stent.material");
-  EXPECT_DOUBLE_EQ(root.child("stent").number_or("missing", 7.0), 7.0);
+  EXPECT_FALSE(root.child("stent").has("missing"));
+}
+
+// Declared keys (protocol/scene/keys.yaml) carry their default, range, values and meaning: the reader
+// gets the default when a key is absent, a message in the declaration's words otherwise; reading an
+// undeclared key, or a key as another type, is a programming error.
+TEST(Scene, DeclaredKeysGiveDefaultsRangesAndValues) {
+  const Node n = inline_scene(
+      "coupling: {max_iterations: 7, rel_tol: 1.5, scheme: bogus}\ntime: {steps: 3}\n"
+      "artery: {layers: {media: {E: 0.1, fibers: [{k1: 0.001, k2: 0}]}}}\nload_curves: {any_name: [[0, 1]]}");
+  const Node c = n.child("coupling");
+  EXPECT_EQ(c.get<int>("max_iterations"), 7);
+  EXPECT_DOUBLE_EQ(c.get<double>("abs_tol"), keys::defaults::coupling_abs_tol);
+  EXPECT_DOUBLE_EQ(keys::defaults::coupling_abs_tol, 1e-6);  // the value keys.yaml declares
+  EXPECT_TRUE(c.get<bool>("strict"));
+  EXPECT_EQ(c.get<std::string>("acceleration"), "aitken");
+  expect_error([&] { c.get<double>("rel_tol"); }, {"coupling.rel_tol", "expected a number in [0, 1)", "'1.5'"});
+  expect_error([&] { c.get<std::string>("scheme"); },
+               {"coupling.scheme", "expected one of dirichlet-neumann, robin", "'bogus'"});
+  expect_error([&] { n.child("time").get<double>("end"); },
+               {"time.end", "missing, expected a number (s): pseudo-time of the last step"});
+  // `*` matches a layer's name, `[]` every entry of a list
+  const Node f = n.child("artery").child("layers").child("media").child("fibers").at(0);
+  EXPECT_DOUBLE_EQ(f.get<double>("k1"), 0.001);
+  expect_error([&] { f.get<double>("k2"); }, {"artery.layers.media.fibers[0].k2", "expected a positive number"});
+  EXPECT_FALSE(f.get<bool>("pair"));
+  EXPECT_NO_THROW(n.child("load_curves").check_keys());
+  EXPECT_THROW(c.get<double>("not_a_key"), std::logic_error);
+  EXPECT_THROW(c.get<double>("max_iterations"), std::logic_error);  // declared an integer
+}
+
+TEST(Scene, DeclaredKeysRefuseUnknownOnesNamingTheNearest) {
+  const Node n = inline_scene("coupling: {rel_tl: 1.0e-3}\nsolid: {newton: {max_iterations: 3}}");
+  expect_error([&] { n.child("coupling").check_keys(); },
+               {"coupling.rel_tl", "unknown key", "did you mean `rel_tol`?"});
+  EXPECT_NO_THROW(n.child("solid").child("newton").check_keys());
 }
 
 TEST(Scene, MissingFileAndSyntaxErrors) {
@@ -50,7 +85,7 @@ TEST(Scene, MissingFileAndSyntaxErrors) {
 TEST(Scene, ErrorsNameFileKeyAndExpectation) {
   Node n = inline_scene("stent: {material: {E: -3, nu: abc}, rings: 2.5, kind: tube, v: [1, 2]}");
   Node m = n.child("stent").child("material");
-  expect_error([&] { m.positive("E"); }, {"inline.yaml", "stent.material.E", "positive", "'-3'"});
+  expect_error([&] { m.get<double>("E"); }, {"inline.yaml", "stent.material.E", "positive", "'-3'"});
   expect_error([&] { m.number("nu"); }, {"stent.material.nu", "a number", "'abc'"});
   expect_error([&] { m.number("G"); }, {"stent.material.G", "missing"});
   expect_error([&] { n.child("stent").integer("rings"); }, {"stent.rings", "integer"});

@@ -70,8 +70,8 @@ ScaledCurve scaled_curve(const Node& parent, const std::string& key, const LoadC
     s.value = n.as_number();
     return s;
   }
-  n.check_keys({"value", "curve"});
-  s.value = n.number_or("value", 1.0);
+  n.check_keys();
+  s.value = n.get<double>("value");
   s.curve = curve_ref(n, "curve", curves);
   return s;
 }
@@ -89,24 +89,22 @@ TimeSettings time_settings(const Node& root) {
   TimeSettings ts;
   auto t = root.optional("time");
   if (!t) return ts;
-  t->check_keys({"start", "end", "steps", "min_step", "max_cuts", "adaptive"});
-  ts.start = t->number_or("start", 0.0);
-  ts.end = t->number("end");
+  t->check_keys();
+  ts.start = t->get<double>("start");
+  ts.end = t->get<double>("end");
   if (!(ts.end > ts.start)) t->child("end").fail("a time larger than time.start");
-  ts.steps = static_cast<int>(t->integer("steps", 1, 1000000));  // more is a typo, not a run
+  ts.steps = t->get<int>("steps");  // at most 1e6: more is a typo, not a run
   const double nominal = (ts.end - ts.start) / ts.steps;
-  ts.min_step = t->positive_or("min_step", nominal / 1024.0);
-  ts.max_cuts = static_cast<int>(t->integer_or("max_cuts", 10, 0));
+  ts.min_step = t->has("min_step") ? t->get<double>("min_step") : nominal / 1024.0;
+  ts.max_cuts = t->get<int>("max_cuts");
   if (const auto a = t->optional("adaptive")) {
-    a->check_keys({"max_step", "easy_iterations"});
-    ts.max_step = a->number("max_step");
+    a->check_keys();
+    ts.max_step = a->get<double>("max_step");
     if (!(ts.max_step > nominal * (1.0 + 1e-12) && ts.max_step <= ts.end - ts.start))
       a->child("max_step")
           .fail("a step larger than the nominal one ((end - start)/steps = " + std::to_string(nominal) +
                 " s) and at most end - start");
-    const long easy = a->integer_or("easy_iterations", ts.easy_iterations, 1);
-    if (easy > 1000) a->child("easy_iterations").fail("at most 1000 iterations");
-    ts.easy_iterations = static_cast<int>(easy);
+    ts.easy_iterations = a->get<int>("easy_iterations");
   }
   for (const auto& [name, curve] : load_curves(root))
     for (const auto& [tc, v] : curve.points())

@@ -1,5 +1,7 @@
 #include "angio/scene/node.hpp"
 
+#include "angio/scene/keys.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -100,37 +102,6 @@ std::array<double, 3> Node::as_vec3() const {
 
 double Node::number(const std::string& key) const { return child(key, "a number").as_number(); }
 
-double Node::number_or(const std::string& key, double fallback) const { return has(key) ? number(key) : fallback; }
-
-double Node::positive(const std::string& key) const {
-  Node c = child(key, "a positive number");
-  double v = c.as_number();
-  if (!(v > 0.0)) c.fail("a positive number");
-  return v;
-}
-
-double Node::positive_or(const std::string& key, double fallback) const { return has(key) ? positive(key) : fallback; }
-
-double Node::non_negative(const std::string& key) const {
-  Node c = child(key, "a non-negative number");
-  double v = c.as_number();
-  if (!(v >= 0.0)) c.fail("a non-negative number");
-  return v;
-}
-
-double Node::non_negative_or(const std::string& key, double fallback) const {
-  return has(key) ? non_negative(key) : fallback;
-}
-
-double Node::in_range(const std::string& key, double lo, double hi) const {
-  std::ostringstream what;
-  what << "a number in [" << lo << ", " << hi << "]";
-  Node c = child(key, what.str());
-  double v = c.as_number();
-  if (v < lo || v > hi) c.fail(what.str());
-  return v;
-}
-
 long Node::integer(const std::string& key, long min, long max) const {
   constexpr long imin = std::numeric_limits<int>::min(), imax = std::numeric_limits<int>::max();
   std::string what = "an integer";
@@ -146,10 +117,6 @@ long Node::integer(const std::string& key, long min, long max) const {
   return v;
 }
 
-long Node::integer_or(const std::string& key, long fallback, long min, long max) const {
-  return has(key) ? integer(key, min, max) : fallback;
-}
-
 bool Node::boolean(const std::string& key) const {
   Node c = child(key, "true or false");
   if (!c.node_.IsScalar()) c.fail("true or false");
@@ -160,13 +127,7 @@ bool Node::boolean(const std::string& key) const {
   }
 }
 
-bool Node::boolean_or(const std::string& key, bool fallback) const { return has(key) ? boolean(key) : fallback; }
-
 std::string Node::string(const std::string& key) const { return child(key, "a string").as_string(); }
-
-std::string Node::string_or(const std::string& key, const std::string& fallback) const {
-  return has(key) ? string(key) : fallback;
-}
 
 static std::string one_of(std::initializer_list<const char*> allowed) {
   std::string s = "one of";
@@ -182,9 +143,108 @@ std::string Node::choice(const std::string& key, std::initializer_list<const cha
   c.fail(one_of(allowed));
 }
 
-std::string Node::choice_or(const std::string& key, std::initializer_list<const char*> allowed,
-                            const std::string& fallback) const {
-  return has(key) ? choice(key, allowed) : fallback;
+const keys::Decl& Node::declaration(const std::string& key) const {
+  const keys::Decl* d = keys::find(child_path(key));
+  if (!d)
+    throw std::logic_error("scene key '" + child_path(key) + "' is read but not declared in protocol/scene/keys.yaml");
+  return *d;
+}
+
+namespace {
+// The declaration of a key read as `type`; a reader asking for another type is a programming error.
+const keys::Decl& typed(const Node& n, const std::string& key, const char* type) {
+  const keys::Decl& d = n.declaration(key);
+  if (!keys::has_type(d, type))
+    throw std::logic_error("scene key '" + (n.path().empty() ? key : n.path() + "." + key) + "' is declared as " +
+                           d.type + ", read as " + type);
+  return d;
+}
+
+bool in_range(const keys::Decl& d, double v) {
+  return (d.lo_open ? v > d.lo : v >= d.lo) && (d.hi_open ? v < d.hi : v <= d.hi);
+}
+}  // namespace
+
+[[noreturn]] static void missing(const Node& n, const std::string& key, const keys::Decl& d) {
+  n.child(key, std::string(d.expected) + ": " + d.doc);
+  throw std::logic_error("unreachable");
+}
+
+namespace {
+// The scalar `key` of `n` converted by yaml-cpp to T, or its declared default (converted from the
+// table's number) when absent; a value that does not convert fails with the declared expectation.
+template <class T>
+std::pair<T, std::optional<Node>> declared_scalar(const Node& n, const std::string& key, const char* type) {
+  const keys::Decl& d = typed(n, key, type);
+  if (!n.has(key)) {
+    if (!d.has_default) missing(n, key, d);
+    return {static_cast<T>(d.default_number), std::nullopt};
+  }
+  const Node c = n.child(key);
+  if (!c.is_scalar()) c.fail(d.expected);
+  try {
+    return {c.yaml().as<T>(), c};
+  } catch (const YAML::Exception&) {
+    c.fail(d.expected);
+  }
+}
+}  // namespace
+
+template <>
+double Node::get<double>(const std::string& key) const {
+  const auto [v, given] = declared_scalar<double>(*this, key, "number");
+  const keys::Decl& d = declaration(key);
+  if (given && (!std::isfinite(v) || !in_range(d, v))) given->fail(d.expected);
+  return v;
+}
+
+template <>
+long Node::get<long>(const std::string& key) const {
+  const auto [v, given] = declared_scalar<long>(*this, key, "integer");
+  // every integer key fits an int, so that callers may cast (4294967296 would wrap around to 0)
+  constexpr double imin = std::numeric_limits<int>::min(), imax = std::numeric_limits<int>::max();
+  const keys::Decl& d = declaration(key);
+  const double x = static_cast<double>(v);
+  if (given && (!in_range(d, x) || x < imin || x > imax)) given->fail(d.expected);
+  return v;
+}
+
+template <>
+int Node::get<int>(const std::string& key) const {
+  return static_cast<int>(get<long>(key));
+}
+
+template <>
+bool Node::get<bool>(const std::string& key) const {
+  return declared_scalar<bool>(*this, key, "boolean").first;
+}
+
+template <>
+std::string Node::get<std::string>(const std::string& key) const {
+  const keys::Decl& d = typed(*this, key, "string");
+  if (!has(key)) {
+    if (d.has_default) return d.default_string;
+    missing(*this, key, d);
+  }
+  const Node c = child(key);
+  if (!c.node_.IsScalar()) c.fail(d.expected);
+  const std::string v = c.node_.Scalar();
+  if (!keys::allows(d, v)) c.fail(d.expected);
+  return v;
+}
+
+template <>
+std::array<double, 3> Node::get<std::array<double, 3>>(const std::string& key) const {
+  const keys::Decl& d = typed(*this, key, "point");
+  if (!has(key)) missing(*this, key, d);
+  return child(key).as_vec3();
+}
+
+template <>
+std::vector<double> Node::get<std::vector<double>>(const std::string& key) const {
+  const keys::Decl& d = typed(*this, key, "numbers");
+  if (!has(key)) missing(*this, key, d);
+  return child(key).as_numbers();
 }
 
 std::array<double, 3> Node::vec3(const std::string& key) const {
@@ -198,6 +258,15 @@ std::vector<long> Node::integers(const std::string& key) const {
   std::vector<long> out;
   for (std::size_t i = 0; i < c.size(); ++i) out.push_back(c.at(i).as_integer());
   return out;
+}
+
+void Node::check_keys() const {
+  const std::vector<std::string> declared = keys::children(path_);
+  if (std::find(declared.begin(), declared.end(), "*") != declared.end()) {
+    if (!node_.IsMap()) fail("a map");
+    return;
+  }
+  check_keys(declared);
 }
 
 void Node::check_keys(std::initializer_list<const char*> allowed) const {

@@ -5,9 +5,9 @@ namespace angio::scene {
 OutputSettings output_settings(const Node& root) {
   OutputSettings o;
   if (auto out = root.optional("output")) {
-    out->check_keys({"every", "state"});
-    o.every = int(out->integer_or("every", o.every, 1));
-    o.state = out->boolean_or("state", o.state);
+    out->check_keys();
+    o.every = out->get<int>("every");
+    o.state = out->get<bool>("state");
   }
   return o;
 }

@@ -10,6 +10,7 @@
 
 #include "angio/beam/element.hpp"
 #include "angio/beam/linear_solver.hpp"
+#include "angio/scene/keys_generated.hpp"
 
 namespace angio::beam {
 
@@ -65,15 +66,16 @@ struct PrescribedRotation {  // node rotation R = exp(value·curve(t)); all rota
 };
 
 struct NewtonOptions {
-  int max_iterations = 30;
-  double residual_tol = 1e-8;       // absolute, N (norm of the free residual vector)
-  double residual_rel_tol = 1e-10;  // relative to the first residual of the solve
-  double increment_tol = 1e-8;      // norm of the last Newton increment (mm, rad)
+  // the scene's stent.solver keys (protocol/scene/keys.yaml): meaning and defaults there
+  int max_iterations = scene::keys::defaults::stent_solver_max_iterations;
+  double residual_tol = scene::keys::defaults::stent_solver_residual_tol;          // N
+  double residual_rel_tol = scene::keys::defaults::stent_solver_residual_rel_tol;  // of the first residual
+  double increment_tol = scene::keys::defaults::stent_solver_increment_tol;        // mm, rad
   // Backtracking (energy-norm criterion) on every iteration; off by default because the
   // plain Newton step converges faster for beams. NaN/Inf always triggers backtracking.
-  bool line_search = false;
+  bool line_search = scene::keys::defaults::stent_solver_line_search;
   int max_line_search = 6;
-  std::string linear_solver = "klu";  // "umfpack", "klu" or "sparselu"
+  std::string linear_solver = scene::keys::defaults::stent_solver_linear_solver;
 };
 
 struct NewtonStats {

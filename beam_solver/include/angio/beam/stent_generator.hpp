@@ -28,19 +28,21 @@
 
 #include "angio/beam/material.hpp"
 #include "angio/geometry/centerline.hpp"
+#include "angio/scene/keys_generated.hpp"
 
 namespace angio::beam {
 
 struct StentParameters {
-  int rings = 4;
-  int crowns = 8;                  // crowns per ring side (2·crowns struts per ring)
-  double crimped_diameter = 1.15;  // mm, diameter of the node cylinder
-  double strut_height = 1.5;       // mm, axial height of a strut (crown height)
-  double ring_pitch = 1.5;         // mm, axial distance between rings
-  int connectors = 2;              // per gap between neighbouring rings
-  int elements_per_strut = 3;
-  int elements_per_connector = 3;
-  double start = -1;  // arc length on the centerline where the stent starts (−1: centred)
+  // the scene's stent.generator keys (protocol/scene/keys.yaml): meaning and defaults there
+  int rings = scene::keys::defaults::stent_generator_rings;
+  int crowns = scene::keys::defaults::stent_generator_crowns;  // per ring side (2·crowns struts per ring)
+  double crimped_diameter = scene::keys::defaults::stent_generator_crimped_diameter;  // mm, node cylinder
+  double strut_height = scene::keys::defaults::stent_generator_strut_height;          // mm, crown height
+  double ring_pitch = scene::keys::defaults::stent_generator_ring_pitch;              // mm
+  int connectors = scene::keys::defaults::stent_generator_connectors;  // per gap between neighbouring rings
+  int elements_per_strut = scene::keys::defaults::stent_generator_elements_per_strut;
+  int elements_per_connector = scene::keys::defaults::stent_generator_elements_per_connector;
+  double start = scene::keys::defaults::stent_generator_start;  // mm of centerline arc length (−1: centred)
 };
 
 struct StentMesh {

@@ -19,15 +19,17 @@
 #include <vector>
 
 #include "angio/coupler/acceleration.hpp"
+#include "angio/scene/keys_generated.hpp"
 
 namespace angio::coupler {
 
 struct IqnIlsOptions {
-  double initial_relaxation = 0.5;  // ω_0 for the very first update
-  int reused_steps = 8;             // accepted steps whose columns stay in the model
-  int max_columns = 100;            // all columns together (newest kept)
-  double filter = 1e-2;             // QR2 filter threshold
-  double stagnation = 1e-3;         // restart when ||q_{k+1} − q_k|| < stagnation ||r_k||
+  double initial_relaxation = scene::keys::defaults::coupling_initial_relaxation;  // ω_0 of the first update
+  int reused_steps = scene::keys::defaults::coupling_iqn_reused_steps;             // accepted steps whose columns stay
+  int max_columns = scene::keys::defaults::coupling_iqn_max_columns;               // all columns together (newest kept)
+  double filter = scene::keys::defaults::coupling_iqn_filter;                      // QR2 filter threshold
+  // restart when ||q_{k+1} − q_k|| < stagnation ||r_k||
+  double stagnation = scene::keys::defaults::coupling_iqn_stagnation;
 };
 
 class IqnIls : public Acceleration {

@@ -20,6 +20,7 @@
 #pragma once
 #include <memory>
 #include <optional>
+#include <string_view>
 
 #include "angio/scene/load_curve.hpp"
 #include "angio/scene/node.hpp"
@@ -34,16 +35,18 @@ struct ContactSpec {
   std::optional<PenaltySurfaceContact::Options> balloon_artery = PenaltySurfaceContact::Options{};
   double stent_balloon_from = kAlwaysActive, stent_artery_from = kAlwaysActive;  // s
   struct Insertion {
-    std::vector<Vec3d> axis;    // mm
-    bool balloon_axis = false;  // axis: balloon (SolidScene::balloon_spine)
-    scene::ScaledCurve radius;  // mm
-    double penalty = 100.0;     // N/mm^3
+    std::vector<Vec3d> axis;                                            // mm
+    bool balloon_axis = false;                                          // axis: balloon (SolidScene::balloon_spine)
+    scene::ScaledCurve radius;                                          // mm
+    double penalty = scene::keys::defaults::contact_insertion_penalty;  // N/mm^3
   };
   std::optional<Insertion> insertion;
-  double search_radius = 0.3;
-  double line_regularization = 0.0;    // g0, mm (line_contact.hpp LineContactParams::regularization)
-  bool line_averaged_normals = false;  // LineContactParams::averaged_normals
-  bool log = true;
+  double search_radius = scene::keys::defaults::contact_search_radius;  // mm
+  // g0, mm (line_contact.hpp LineContactParams::regularization)
+  double line_regularization = scene::keys::defaults::contact_line_regularization;
+  bool line_averaged_normals =  // LineContactParams::averaged_normals
+      std::string_view(scene::keys::defaults::contact_line_normals) == "averaged";
+  bool log = scene::keys::defaults::contact_log;
 };
 
 // Throws scene::SceneError ("file: contact.key: expected ...").

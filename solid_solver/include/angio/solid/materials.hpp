@@ -5,7 +5,10 @@
 #include <Eigen/Dense>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "angio/scene/keys_generated.hpp"
 
 namespace angio::solid {
 
@@ -66,7 +69,9 @@ struct FiberSpec {
 //               that stress, then the anisotropic summands), the code the paper was computed with.
 //   all       – the whole S∞ = S_iso + S_fibers (eqs. B.7–B.8 read literally).
 enum class ViscousActsOn { isotropic, all };
-inline constexpr ViscousActsOn kViscousActsOnDefault = ViscousActsOn::isotropic;  // 4C's placement
+inline constexpr ViscousActsOn kViscousActsOnDefault =  // 4C's placement (protocol/scene/keys.yaml)
+    std::string_view(scene::keys::defaults::artery_layers_viscous_acts_on) == "isotropic" ? ViscousActsOn::isotropic
+                                                                                          : ViscousActsOn::all;
 inline const char* to_string(ViscousActsOn a) { return a == ViscousActsOn::isotropic ? "isotropic" : "all"; }
 
 // Parameters of the viscous branch of a layer (paper eqs. B.5–B.8; kernel in viscous.hpp).

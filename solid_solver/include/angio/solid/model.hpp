@@ -13,9 +13,11 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "angio/solid/mesh.hpp"
+#include "angio/scene/keys_generated.hpp"
 #include "angio/solid/viscous.hpp"
 
 namespace angio::solid {
@@ -32,13 +34,14 @@ class ContactModel {
   virtual void add(const SolidModel& model, Vec r, Mat K) = 0;
 };
 
+// The scene's solid.newton keys (protocol/scene/keys.yaml): meaning and defaults there.
 struct NewtonOptions {
-  int max_iterations = 30;
-  double rtol = 1e-8;       // ||r|| <= rtol * ||r_0|| (r_0: first residual of the solve)
-  double atol = 1e-9;       // or ||r|| <= atol (N)
-  bool line_search = true;  // backtracking on ||r|| (halving, up to max_line_search times)
-  int max_line_search = 6;
-  bool verbose = false;  // per-iteration log on rank 0
+  int max_iterations = scene::keys::defaults::solid_newton_max_iterations;
+  double rtol = scene::keys::defaults::solid_newton_rtol;              // ||r|| <= rtol * ||r_0|| (r_0: first residual)
+  double atol = scene::keys::defaults::solid_newton_atol;              // or ||r|| <= atol (N)
+  bool line_search = scene::keys::defaults::solid_newton_line_search;  // backtracking on ||r|| (halving)
+  int max_line_search = scene::keys::defaults::solid_newton_max_line_search;
+  bool verbose = scene::keys::defaults::solid_newton_verbose;  // per-iteration log on rank 0
   // Artificial viscous damping over the pseudo-time (as Abaqus' *STATIC, STABILIZE): each node gets
   // the force η·V_a·(u_a − u_a,committed)/Δt, V_a its share of the element volumes, Δt the time since
   // the last commit; η in N·s/mm⁴. It carries a load step over a limit point or bifurcation of the
@@ -46,7 +49,7 @@ struct NewtonOptions {
   // solve). Being viscous, it depends on the load rate, not on the step: a cut step is damped as
   // strongly per unit rate and its tangent term η·V_a/Δt grows, where a spring toward the committed
   // state would weaken with the shorter increment. 0 = off.
-  double damping = 0.0;
+  double damping = scene::keys::defaults::solid_newton_damping;
   // The parts (Block::part, e.g. "balloon") whose elements get the damping; empty: every element. A
   // balloon's unfolding needs it, an artery must not carry its blood pressure by viscosity.
   std::vector<std::string> damping_parts;
@@ -57,7 +60,7 @@ struct NewtonOptions {
   // as an assembly (34k DOFs: 0.7 s against 0.25 s), GMRES iterations with an old factor a fraction
   // of that. The Newton iteration itself keeps the exact tangent (quadratic convergence as long as
   // the Krylov tolerance is tight). 0 = refactorize at every iteration.
-  int reuse_preconditioner = 0;
+  int reuse_preconditioner = scene::keys::defaults::solid_newton_reuse_preconditioner;
   // Modified Newton (tangent: modified): the factorization of an earlier tangent is kept across Newton
   // iterations, solves (coupling iterations) and steps as long as each iteration reduces ||r|| by at
   // least the factor max_contraction; iterations with it assemble the residual only (no element
@@ -66,8 +69,8 @@ struct NewtonOptions {
   // repeated with the current tangent. Linear convergence instead of quadratic, at a fraction of the
   // cost per iteration: pays off where the factorization dominates and the tangent changes slowly
   // between solves (the solid in a coupling loop). Exact Newton (false) factorizes every iteration.
-  bool modified = false;
-  double max_contraction = 0.25;
+  bool modified = std::string_view(scene::keys::defaults::solid_newton_tangent) == "modified";
+  double max_contraction = scene::keys::defaults::solid_newton_max_contraction;
   // Continuation of a failed solve: if Newton fails from the last converged state of the step (or
   // the committed one), the change since that state (pseudo-time with its pressures, prescribed
   // displacements, viscous and damping increments, and the stent's sample points) is applied in
@@ -77,7 +80,7 @@ struct NewtonOptions {
   // of the coupler, without repeating the coupling iterations of the step). 0 = off. Default 4
   // (λ = ½ and 1, one halving): every solve carried in the generic artery needed at most one
   // halving, and a hopeless step (a stent inside the wall) pays at most two extra solves per cut.
-  int continuation = 4;
+  int continuation = scene::keys::defaults::solid_newton_continuation;
   // First iterate of a load step: the committed state (false), or the committed state moved on by the
   // last step's motion scaled to this step's increment, u_n + (Δt/Δt_prev)(u_n − u_n−1) (true; a
   // linear extrapolation in the pseudo-time, as the coupler's `prediction: extrapolate` for the
@@ -86,12 +89,13 @@ struct NewtonOptions {
   // Off by default: it saves 11 % of the straight free expansion's Newton iterations, but in the
   // generic artery's indentation phase, where Newton is limited by the stiffening wall at the stent
   // ends rather than by the distance from the start, it cost a cut step (solid_solver/README.md).
-  bool extrapolate = false;
+  bool extrapolate = std::string_view(scene::keys::defaults::solid_newton_prediction) == "extrapolate";
 };
 
 struct ModelOptions {
-  std::string partitioner = "contiguous";  // "contiguous" or a MatPartitioning type (ptscotch, parmetis, average...)
-  std::string petsc_options;               // appended after the defaults (GMRES(200) + block-Jacobi ILU(1))
+  // "contiguous" or a MatPartitioning type (ptscotch, parmetis, average...)
+  std::string partitioner = scene::keys::defaults::solid_partitioner;
+  std::string petsc_options;  // appended after the defaults (GMRES(200) + block-Jacobi ILU(1))
   NewtonOptions newton;
   Axis axis;  // fiber frames if the mesh has none
 };

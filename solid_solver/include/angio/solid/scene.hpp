@@ -61,8 +61,8 @@ struct SolidScene {
   // Artery summary (artery.summary): lumen stations along the vessel axis (artery_inner nodes) and the
   // apposition threshold (a strut farther than this from the endothelium is malapposed).
   std::optional<DiameterSpec> lumen;  // node_set: "artery_inner"
-  int lumen_max_stations = 100;
-  double apposition_threshold = 0.1;  // mm
+  int lumen_max_stations = scene::keys::defaults::artery_summary_lumen_stations;
+  double apposition_threshold = scene::keys::defaults::artery_summary_apposition_threshold;  // mm
   bool has_balloon = false, has_artery = false;
   int ranks = 0;  // solid.ranks (0: not given)
   // Norm of the nodal force vector of all pressures at their curves' peaks, reference mesh (N): the

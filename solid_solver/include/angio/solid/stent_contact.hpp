@@ -57,11 +57,11 @@ inline constexpr double kAlwaysActive = -std::numeric_limits<double>::infinity()
 class PenaltyStentContact : public StentContact {
  public:
   struct Options {
-    std::optional<double> balloon_penalty;  // N/mm^2; unset: no stent-balloon contact
-    std::optional<double> artery_penalty;   // N/mm^2; unset: no stent-artery contact
-    double search_radius = 0.3;             // mm; must exceed R + the largest penetration
-    double regularization = 0.0;            // g0 (mm) of the linear-quadratic law (line_contact.hpp)
-    bool averaged_normals = false;          // projection along the averaged normal field (line_contact.hpp)
+    std::optional<double> balloon_penalty;                                // N/mm^2; unset: no stent-balloon contact
+    std::optional<double> artery_penalty;                                 // N/mm^2; unset: no stent-artery contact
+    double search_radius = scene::keys::defaults::contact_search_radius;  // mm; > R + the largest penetration
+    double regularization = 0.0;    // g0 (mm) of the linear-quadratic law (line_contact.hpp)
+    bool averaged_normals = false;  // projection along the averaged normal field (line_contact.hpp)
     std::string balloon_surface = "balloon_outer";
     std::string artery_surface = "artery_inner";
     double balloon_from = kAlwaysActive, artery_from = kAlwaysActive;  // s: off before these times
@@ -105,11 +105,12 @@ class PenaltyStentContact : public StentContact {
 class PenaltySurfaceContact : public ContactModel {
  public:
   struct Options {
-    double penalty = 5.0;         // N/mm^3 (pressure per penetration)
-    int quadrature = 3;           // slave face rule degree (3: quad 2x2)
-    double regularization = 0.0;  // mm: C1 law active below this gap (contact::SurfaceContactParams)
-    bool two_pass = false;
-    double search_radius = 0.3;
+    // the scene's contact.balloon_artery keys (protocol/scene/keys.yaml): meaning and defaults there
+    double penalty = scene::keys::defaults::contact_balloon_artery_penalty;     // N/mm^3 (pressure per penetration)
+    int quadrature = scene::keys::defaults::contact_balloon_artery_quadrature;  // slave face rule degree
+    double regularization = scene::keys::defaults::contact_balloon_artery_regularization;  // mm: C1 law below
+    bool two_pass = scene::keys::defaults::contact_balloon_artery_two_pass;
+    double search_radius = scene::keys::defaults::contact_search_radius;
     std::string slave = "balloon_outer";
     std::string master = "artery_inner";
     double from = kAlwaysActive;  // s: off before this time

@@ -56,16 +56,16 @@ ScaledCurve scaled_curve(const Node& parent, const std::string& key, const LoadC
 
 // The `time:` section: pseudo-time interval and load steps, shared by all participants.
 struct TimeSettings {
-  double start = 0.0;
-  double end = 1.0;
+  double start = keys::defaults::time_start;
+  double end = 1.0;  // end and steps without a `time:` section: one step from 0 to 1
   int steps = 1;
   double min_step = 0.0;  // smallest step the stepper may cut down to (default: initial/1024)
-  int max_cuts = 10;
+  int max_cuts = keys::defaults::time_max_cuts;
   // Adaptive steps (time.adaptive; off: max_step = 0): after a step that needed at most
   // easy_iterations iterations (coupling iterations, or Newton iterations of a participant alone)
   // the increment doubles, up to max_step; after a harder step it is the nominal one again.
   double max_step = 0.0;
-  int easy_iterations = 1;
+  int easy_iterations = keys::defaults::time_adaptive_easy_iterations;
   // Times no step crosses: the corners of the load curves inside (start, end), sorted. A larger
   // step lands on them (and on the nominal grid), so a peak of a curve is always hit exactly.
   std::vector<double> stops;

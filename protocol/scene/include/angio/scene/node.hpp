@@ -7,6 +7,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "angio/scene/keys_generated.hpp"
+
 #include <array>
 #include <initializer_list>
 #include <limits>
@@ -45,27 +47,24 @@ class Node {
   Node at(std::size_t i) const;
   std::vector<std::string> keys() const;  // throws unless this node is a map
 
-  // Scalars read from a child key.
+  // Declared keys (protocol/scene/keys.yaml, the one place of each key's type, unit, default and
+  // range): the value of the child `key`, or its declared default when absent; a value of the wrong
+  // type or outside the declared range or values fails naming the key, and so does an absent key
+  // without a default. T: double (number), long or int (integer), bool (boolean), std::string
+  // (string), std::array<double, 3> (point), std::vector<double> (numbers). Reading a key that is not
+  // declared, or as another type, is a programming error (std::logic_error).
+  template <class T>
+  T get(const std::string& key) const;
+  // The declaration of the child `key` (std::logic_error when undeclared).
+  const keys::Decl& declaration(const std::string& key) const;
+
+  // Scalars read from a child key without a declaration (the raw building blocks).
   double number(const std::string& key) const;
-  double number_or(const std::string& key, double fallback) const;
-  double positive(const std::string& key) const;                      // > 0
-  double positive_or(const std::string& key, double fallback) const;  // > 0 when given
-  double non_negative(const std::string& key) const;                  // >= 0
-  double non_negative_or(const std::string& key, double fallback) const;
-  double in_range(const std::string& key, double lo, double hi) const;  // lo <= v <= hi
-  // Integers are range-checked before any caller casts them: by default to the range of int, so a
-  // count such as `steps: 4294967296` is refused here instead of wrapping around to 0 in an int.
   long integer(const std::string& key, long min = std::numeric_limits<int>::min(),
                long max = std::numeric_limits<int>::max()) const;
-  long integer_or(const std::string& key, long fallback, long min = std::numeric_limits<int>::min(),
-                  long max = std::numeric_limits<int>::max()) const;
   bool boolean(const std::string& key) const;
-  bool boolean_or(const std::string& key, bool fallback) const;
   std::string string(const std::string& key) const;
-  std::string string_or(const std::string& key, const std::string& fallback) const;
   std::string choice(const std::string& key, std::initializer_list<const char*> allowed) const;
-  std::string choice_or(const std::string& key, std::initializer_list<const char*> allowed,
-                        const std::string& fallback) const;
   std::array<double, 3> vec3(const std::string& key) const;
   std::vector<double> numbers(const std::string& key) const;
   std::vector<long> integers(const std::string& key) const;
@@ -77,8 +76,10 @@ class Node {
   std::array<double, 3> as_vec3() const;
   std::vector<double> as_numbers() const;
 
-  // Rejects keys not in `allowed` (catches typos such as "pressur:"), naming the offending key and
-  // the nearest allowed one ("did you mean `pressure`?").
+  // Rejects keys not declared under this node (catches typos such as "pressur:"), naming the
+  // offending key and the nearest declared one ("did you mean `pressure`?").
+  void check_keys() const;
+  // The same against a given list (e.g. the keys of one variant of a section, a mesh from a file).
   void check_keys(std::initializer_list<const char*> allowed) const;
   void check_keys(const std::vector<std::string>& allowed) const;
 
@@ -93,6 +94,21 @@ class Node {
   std::string file_;
   std::string path_;
 };
+
+template <>
+double Node::get<double>(const std::string& key) const;
+template <>
+long Node::get<long>(const std::string& key) const;
+template <>
+int Node::get<int>(const std::string& key) const;
+template <>
+bool Node::get<bool>(const std::string& key) const;
+template <>
+std::string Node::get<std::string>(const std::string& key) const;
+template <>
+std::array<double, 3> Node::get<std::array<double, 3>>(const std::string& key) const;
+template <>
+std::vector<double> Node::get<std::vector<double>>(const std::string& key) const;
 
 // Loads and parses a scene file; throws SceneError naming the file on I/O or syntax errors, and on a
 // key given twice in one map (yaml-cpp would silently read the first, the launcher the last).

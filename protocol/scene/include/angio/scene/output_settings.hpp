@@ -6,10 +6,10 @@
 namespace angio::scene {
 
 struct OutputSettings {
-  int every = 1;  // fields at every `every`-th committed step (and the first)
+  int every = keys::defaults::output_every;  // fields at every `every`-th committed step (and the first)
   // A state file (<run>/<solver>/state.h5) rewritten at the steps with fields and at the end of the
   // run: the committed state a later run starts from (solid.initial_state, stent.initial_state).
-  bool state = true;
+  bool state = keys::defaults::output_state;
 };
 // Reads `output:` (absent: the defaults); unknown keys are refused.
 OutputSettings output_settings(const Node& root);

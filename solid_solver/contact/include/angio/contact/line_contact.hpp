@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "angio/contact/search.hpp"
+#include "angio/scene/keys_generated.hpp"
 
 namespace angio::contact {
 
@@ -22,7 +23,9 @@ struct BeamPoint {
 
 // The paper's line-contact penalty for stent–balloon and stent–artery (§2.5: ε = 10 N/mm², a line
 // load per mm of penetration), the default of every line-contact pair.
-inline constexpr double kLinePenaltyDefault = 10.0;
+inline constexpr double kLinePenaltyDefault = scene::keys::defaults::contact_stent_balloon_penalty;
+static_assert(scene::keys::defaults::contact_stent_balloon_penalty ==
+              scene::keys::defaults::contact_stent_artery_penalty);
 
 struct LineContactParams {
   double penalty = kLinePenaltyDefault;  // eps (N/mm^2)

@@ -18,11 +18,15 @@
 namespace angio::contact {
 
 struct SurfaceContactParams {
-  double penalty = 5.0;         // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see
-                                // solid_solver/contact/README.md
-  int quadrature_degree = 3;    // slave quadrature (face_rule): quad 2x2, tri 6 points
-  double regularization = 0.0;  // g0 (mm): C1 law, active where g_N < g0; 0: the paper's quadratic potential
-  bool two_pass = false;        // symmetric: both surfaces act as slave, each pass with eps/2
+  // the defaults of the scene's contact.balloon_artery (protocol/scene/keys.yaml)
+  // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see solid_solver/contact/README.md
+  double penalty = scene::keys::defaults::contact_balloon_artery_penalty;
+  // slave quadrature degree (face_rule): 3 = quad 2x2, tri 6 points
+  int quadrature_degree = scene::keys::defaults::contact_balloon_artery_quadrature;
+  // g0 (mm): C1 law, active where g_N < g0; 0: the paper's quadratic potential
+  double regularization = scene::keys::defaults::contact_balloon_artery_regularization;
+  // symmetric: both surfaces act as slave, each pass with eps/2
+  bool two_pass = scene::keys::defaults::contact_balloon_artery_two_pass;
   bool compute_tangent = true;
   ProjectionOptions projection;
 };
