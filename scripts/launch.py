@@ -43,7 +43,7 @@ import scene_keys  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 UNIX_PATH_MAX = 107
-# The top-level sections some executable reads (protocol/scene/keys.yaml). The launcher picks the
+# The top-level sections some executable reads (core/scene/keys.yaml). The launcher picks the
 # processes from these keys, so a misspelt one must stop the launch instead of silently running
 # another simulation (a scene without its `stent` runs the balloon alone).
 SECTIONS = tuple(scene_keys.children(""))

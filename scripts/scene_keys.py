@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The scene keys declared in protocol/scene/keys.yaml: lookup, defaults and checks for the Python
+"""The scene keys declared in core/scene/keys.yaml: lookup, defaults and checks for the Python
 tools, the C++ header the build compiles, and the reference page docs/scene-keys.md.
 
   scripts/scene_keys.py --write           rewrite docs/scene-keys.md
@@ -21,7 +21,7 @@ from pathlib import Path
 import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
-KEYS_FILE = ROOT / "protocol" / "scene" / "keys.yaml"
+KEYS_FILE = ROOT / "core" / "scene" / "keys.yaml"
 REFERENCE = ROOT / "docs" / "scene-keys.md"
 TYPES = ("number", "integer", "boolean", "string", "point", "numbers", "map", "list", "any")
 FIELDS = ("type", "unit", "default", "default_text", "range", "values", "doc", "optional")
@@ -280,7 +280,7 @@ def reference_markdown():
     lines = [
         "# Scene keys",
         "",
-        "Generated from `protocol/scene/keys.yaml` by `scripts/scene_keys.py --write`; do not edit by hand (the",
+        "Generated from `core/scene/keys.yaml` by `scripts/scene_keys.py --write`; do not edit by hand (the",
         "test `scene_keys.reference` fails when this page is stale). Units: mm, N, MPa, s. `*` is any name (a",
         "layer, a load curve), `[]` every entry of a list. A key whose default is **required** must be given",
         "when its section is; *optional* means that absent it is off or not used.",
@@ -377,7 +377,7 @@ def cpp_header():
                 consts.append(f"inline constexpr const char* {name} = {_cpp_string(d.default)};")
     return "\n".join(
         [
-            "// Generated from protocol/scene/keys.yaml by scripts/scene_keys.py --cpp; do not edit.",
+            "// Generated from core/scene/keys.yaml by scripts/scene_keys.py --cpp; do not edit.",
             "#pragma once",
             "#include <cstddef>",
             "#include <limits>",

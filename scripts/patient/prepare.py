@@ -27,7 +27,7 @@ from .lumen_centerline import lumen_centerline
 from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 
-# The keys of `patient:` (their types, defaults and ranges) are declared in protocol/scene/keys.yaml
+# The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
 # and checked by scene_keys.check_map.
 # A lesion narrower than a crimped device: a rigid capsule along the balloon axis (contact.insertion)
 # opens the lumen to the devices' outer radius plus `clearance` during the blood-pressure phase, the

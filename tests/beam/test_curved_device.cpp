@@ -1,7 +1,7 @@
 // The curved free-expansion scene's stent (configs/curved_free_expansion.yaml, paper §3.2): the
 // 11-ring stent warped onto the same centerline file as the balloon. Compared with the paper's
 // counts (588 elements), the crimped radius 0.575 mm measured from the shared centerline
-// (protocol/geometry Centerline::closest, to round-off), and the balloon's placement (both
+// (core/geometry Centerline::closest, to round-off), and the balloon's placement (both
 // centred: equal mid arc lengths).
 #include <gtest/gtest.h>
 

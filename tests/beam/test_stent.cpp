@@ -95,7 +95,7 @@ TEST(StentGenerator, WarpedStentKeepsStrutLengths) {
   for (const auto& x : warped.nodes) EXPECT_NEAR(c.closest(x).distance, 0.575, 1e-12);
 }
 
-// Rotation-minimizing frames: see tests/geometry/test_centerline.cpp (protocol/geometry).
+// Rotation-minimizing frames: see tests/geometry/test_centerline.cpp (core/geometry).
 
 // The shipped scenes parse; a bad value gives "file: key.path: expected …".
 TEST(BeamScene, ShippedConfigsParse) {

@@ -1,4 +1,4 @@
-// Centerline of a curved device (protocol/geometry, paper §2.4: warp without stretching the
+// Centerline of a curved device (core/geometry, paper §2.4: warp without stretching the
 // centerline, minimal twist). Each test names what it compares against.
 #include <gtest/gtest.h>
 

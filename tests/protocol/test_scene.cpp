@@ -42,7 +42,7 @@ TEST(Scene, ReadsValuesWithPaths) {
   EXPECT_FALSE(root.child("stent").has("missing"));
 }
 
-// Declared keys (protocol/scene/keys.yaml) carry their default, range, values and meaning: the reader
+// Declared keys (core/scene/keys.yaml) carry their default, range, values and meaning: the reader
 // gets the default when a key is absent, a message in the declaration's words otherwise; reading an
 // undeclared key, or a key as another type, is a programming error.
 TEST(Scene, DeclaredKeysGiveDefaultsRangesAndValues) {

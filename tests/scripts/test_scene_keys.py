@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The scene-key declarations (protocol/scene/keys.yaml, scripts/scene_keys.py): every key of every
+"""The scene-key declarations (core/scene/keys.yaml, scripts/scene_keys.py): every key of every
 shipped scene is declared, the Python checks and defaults follow the declarations, and the tools that
 used to carry their own copy of a default now read the declared one. Consistency tests (no solver).
 
@@ -61,7 +61,7 @@ class SceneKeys(unittest.TestCase):
         for f, scene in shipped_scenes():
             for p in key_paths(scene):
                 n += 1
-                self.assertIsNotNone(scene_keys.declared(p), f"{f}: {p} is not declared in protocol/scene/keys.yaml")
+                self.assertIsNotNone(scene_keys.declared(p), f"{f}: {p} is not declared in core/scene/keys.yaml")
         self.assertGreater(n, 500)  # the walk reached the scenes' keys
 
     def test_lookup_prefers_exact_names_and_matches_list_entries(self):

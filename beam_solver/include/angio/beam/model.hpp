@@ -66,7 +66,7 @@ struct PrescribedRotation {  // node rotation R = exp(value·curve(t)); all rota
 };
 
 struct NewtonOptions {
-  // the scene's stent.solver keys (protocol/scene/keys.yaml): meaning and defaults there
+  // the scene's stent.solver keys (core/scene/keys.yaml): meaning and defaults there
   int max_iterations = scene::keys::defaults::stent_solver_max_iterations;
   double residual_tol = scene::keys::defaults::stent_solver_residual_tol;          // N
   double residual_rel_tol = scene::keys::defaults::stent_solver_residual_rel_tol;  // of the first residual

@@ -18,7 +18,7 @@
 // A curved stent is the straight one warped onto a centerline polyline (paper §2.4): axial
 // coordinate z = arc length along the centerline (no stretching of the centerline) and the
 // cross-section frame transported with minimal twist (rotation-minimizing frame, double
-// reflection method). The warp is angio::geometry::Centerline::map (protocol/geometry), the
+// reflection method). The warp is angio::geometry::Centerline::map (core/geometry), the
 // same map the solid_solver uses for a curved balloon, so stent and balloon share one axis.
 #pragma once
 
@@ -33,7 +33,7 @@
 namespace angio::beam {
 
 struct StentParameters {
-  // the scene's stent.generator keys (protocol/scene/keys.yaml): meaning and defaults there
+  // the scene's stent.generator keys (core/scene/keys.yaml): meaning and defaults there
   int rings = scene::keys::defaults::stent_generator_rings;
   int crowns = scene::keys::defaults::stent_generator_crowns;  // per ring side (2·crowns struts per ring)
   double crimped_diameter = scene::keys::defaults::stent_generator_crimped_diameter;  // mm, node cylinder

@@ -1,5 +1,5 @@
 // The scene's `coupling:` section: its keys, defaults and ranges are declared in
-// protocol/scene/keys.yaml (docs/scene-keys.md); the scheme and the algorithm in docs/design.md.
+// core/scene/keys.yaml (docs/scene-keys.md); the scheme and the algorithm in docs/design.md.
 #pragma once
 
 #include <memory>

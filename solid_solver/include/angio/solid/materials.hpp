@@ -69,7 +69,7 @@ struct FiberSpec {
 //               that stress, then the anisotropic summands), the code the paper was computed with.
 //   all       – the whole S∞ = S_iso + S_fibers (eqs. B.7–B.8 read literally).
 enum class ViscousActsOn { isotropic, all };
-inline constexpr ViscousActsOn kViscousActsOnDefault =  // 4C's placement (protocol/scene/keys.yaml)
+inline constexpr ViscousActsOn kViscousActsOnDefault =  // 4C's placement (core/scene/keys.yaml)
     std::string_view(scene::keys::defaults::artery_layers_viscous_acts_on) == "isotropic" ? ViscousActsOn::isotropic
                                                                                           : ViscousActsOn::all;
 inline const char* to_string(ViscousActsOn a) { return a == ViscousActsOn::isotropic ? "isotropic" : "all"; }

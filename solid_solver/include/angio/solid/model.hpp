@@ -34,7 +34,7 @@ class ContactModel {
   virtual void add(const SolidModel& model, Vec r, Mat K) = 0;
 };
 
-// The scene's solid.newton keys (protocol/scene/keys.yaml): meaning and defaults there.
+// The scene's solid.newton keys (core/scene/keys.yaml): meaning and defaults there.
 struct NewtonOptions {
   int max_iterations = scene::keys::defaults::solid_newton_max_iterations;
   double rtol = scene::keys::defaults::solid_newton_rtol;              // ||r|| <= rtol * ||r_0|| (r_0: first residual)

@@ -105,7 +105,7 @@ class PenaltyStentContact : public StentContact {
 class PenaltySurfaceContact : public ContactModel {
  public:
   struct Options {
-    // the scene's contact.balloon_artery keys (protocol/scene/keys.yaml): meaning and defaults there
+    // the scene's contact.balloon_artery keys (core/scene/keys.yaml): meaning and defaults there
     double penalty = scene::keys::defaults::contact_balloon_artery_penalty;     // N/mm^3 (pressure per penetration)
     int quadrature = scene::keys::defaults::contact_balloon_artery_quadrature;  // slave face rule degree
     double regularization = scene::keys::defaults::contact_balloon_artery_regularization;  // mm: C1 law below

@@ -18,7 +18,7 @@
 namespace angio::contact {
 
 struct SurfaceContactParams {
-  // the defaults of the scene's contact.balloon_artery (protocol/scene/keys.yaml)
+  // the defaults of the scene's contact.balloon_artery (core/scene/keys.yaml)
   // eps: pressure per penetration (MPa/mm = N/mm^3); the paper writes 5 N/mm^2, see solid_solver/contact/README.md
   double penalty = scene::keys::defaults::contact_balloon_artery_penalty;
   // slave quadrature degree (face_rule): 3 = quad 2x2, tri 6 points

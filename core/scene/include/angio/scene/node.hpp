@@ -47,7 +47,7 @@ class Node {
   Node at(std::size_t i) const;
   std::vector<std::string> keys() const;  // throws unless this node is a map
 
-  // Declared keys (protocol/scene/keys.yaml, the one place of each key's type, unit, default and
+  // Declared keys (core/scene/keys.yaml, the one place of each key's type, unit, default and
   // range): the value of the child `key`, or its declared default when absent; a value of the wrong
   // type or outside the declared range or values fails naming the key, and so does an absent key
   // without a default. T: double (number), long or int (integer), bool (boolean), std::string

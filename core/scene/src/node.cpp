@@ -146,7 +146,7 @@ std::string Node::choice(const std::string& key, std::initializer_list<const cha
 const keys::Decl& Node::declaration(const std::string& key) const {
   const keys::Decl* d = keys::find(child_path(key));
   if (!d)
-    throw std::logic_error("scene key '" + child_path(key) + "' is read but not declared in protocol/scene/keys.yaml");
+    throw std::logic_error("scene key '" + child_path(key) + "' is read but not declared in core/scene/keys.yaml");
   return *d;
 }
 

@@ -1,4 +1,4 @@
-// Lookup in the declared scene keys (protocol/scene/keys.yaml, compiled into keys_generated.hpp).
+// Lookup in the declared scene keys (core/scene/keys.yaml, compiled into keys_generated.hpp).
 #pragma once
 
 #include <string>
