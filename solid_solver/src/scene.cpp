@@ -320,6 +320,154 @@ void read_initial_state(const Node& is, const Node& root, SolidScene& sc) {
   sc.initial_parts = std::move(parts);
 }
 
+// balloon: {mesh, material, pressure, end_springs, summary, fixed}
+void read_balloon(const Node& b, const scene::LoadCurves& curves, SolidScene& sc) {
+  sc.has_balloon = true;
+  b.check_keys();
+  Axis axis;
+  std::vector<std::string> req;
+  double length = 0;
+  std::optional<geometry::Centerline> curved;
+  Mesh m = read_part_mesh(b.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false, axis, req,
+                          length, curved);
+  for (auto& blk : m.blocks) blk.name = m.blocks.size() == 1 ? "balloon" : "balloon_" + blk.name;
+  const LayerMaterial mat = read_material(b.child("material", "a material {E, nu, fibers}"), "balloon");
+  const int boff = int(sc.mesh.blocks.size());
+  for (size_t i = 0; i < m.blocks.size(); ++i) {
+    LayerMaterial mi = mat;
+    mi.name = m.blocks[i].name;
+    sc.materials.push_back(mi);
+  }
+  (void)boff;
+  if (b.has("pressure"))
+    sc.pressures.push_back(read_pressure(b, "pressure", "balloon_inner", curves, "balloon_pressure",
+                                         kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
+  if (b.has("end_springs")) {
+    const double k = b.get<double>("end_springs");
+    for (const char* s : {"balloon_end0", "balloon_end1"}) {
+      if (!m.surface(s)) b.child("end_springs").fail("balloon end surfaces (mesh.ends) for the springs");
+      sc.springs.push_back({s, k});
+    }
+  }
+  if (m.node_sets.count("balloon_outer")) {
+    DiameterSpec d;
+    d.node_set = "balloon_outer";
+    d.axis = axis;
+    d.centerline = curved;  // curved balloon: arc-length stations
+    double smin = std::numeric_limits<double>::max(), smax = -smin;
+    for (const auto& x : m.X) {
+      const double s = d.station(x);
+      smin = std::min(smin, s);
+      smax = std::max(smax, s);
+    }
+    double end_offset = std::min(1.7, 0.25 * (smax - smin));
+    if (auto s = b.optional("summary")) {
+      s->check_keys();
+      if (s->has("end_offset")) end_offset = s->get<double>("end_offset");
+      if (!(2 * end_offset < smax - smin))
+        s->child("end_offset").fail("an offset smaller than half the balloon length");
+    }
+    d.s_mid = 0.5 * (smin + smax);
+    d.s_end0 = smin + end_offset;
+    d.s_end1 = smax - end_offset;
+    const int n_spine = curved ? std::max(1, int(std::ceil((smax - smin) / 0.25))) : 1;
+    for (int i = 0; i <= n_spine; ++i) {
+      const double st = smin + (smax - smin) * i / n_spine;
+      sc.balloon_spine.push_back(curved ? Vec3d(curved->point(st)) : Vec3d(axis.origin + st * axis.direction));
+    }
+    sc.balloon_diameter = d;
+  }
+  read_fixed(b, "balloon_", m, sc.fixed);
+  sc.mesh.append(m);
+}
+
+// artery: {mesh, layers, blood_pressure, end_springs, fixed, summary}
+void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc) {
+  sc.has_artery = true;
+  a.check_keys();
+  Axis axis;
+  std::vector<std::string> req;
+  double length = 0;
+  std::optional<geometry::Centerline> curved;
+  Mesh m = read_part_mesh(a.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis, req,
+                          length, curved);
+  const Node layers = a.child("layers", "a map layer name -> material {E, nu, fibers}");
+  if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
+  for (const auto& blk : m.blocks) {
+    if (!layers.has(blk.name)) layers.fail("a material for layer '" + blk.name + "'");
+    sc.materials.push_back(read_material(layers.child(blk.name), blk.name));
+  }
+  for (const auto& k : layers.keys())
+    if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
+  if (a.has("blood_pressure"))
+    sc.pressures.push_back(
+        read_pressure(a, "blood_pressure", "artery_inner", curves, "blood_pressure", kMaxBloodPressure, "300 mmHg"));
+  if (a.has("end_springs")) {
+    const double k = a.get<double>("end_springs");
+    for (const char* s : {"artery_end0", "artery_end1"}) {
+      if (!m.surface(s)) a.child("end_springs").fail("artery end surfaces (mesh.ends) for the springs");
+      sc.springs.push_back({s, k});
+    }
+  }
+  read_fixed(a, "artery_", m, sc.fixed);
+  if (m.surface("artery_inner")) {
+    DiameterSpec d;
+    d.node_set = "artery_inner";
+    d.axis = axis;
+    d.centerline = curved;
+    sc.lumen = d;
+  }
+  if (auto s = a.optional("summary")) {
+    s->check_keys();
+    sc.apposition_threshold = s->get<double>("apposition_threshold");
+    sc.lumen_max_stations = s->get<int>("lumen_stations");
+  }
+  sc.mesh.append(m);
+}
+
+// solid: {ranks, partitioner, petsc_options, newton} (initial_state once the mesh is complete)
+void read_solver_options(const Node& s, SolidScene& sc) {
+  s.check_keys();
+  sc.ranks = s.has("ranks") ? s.get<int>("ranks") : 0;
+  sc.options.partitioner = s.get<std::string>("partitioner");
+  sc.options.petsc_options = s.get<std::string>("petsc_options");
+  if (auto n = s.optional("newton")) {
+    n->check_keys();
+    auto& no = sc.options.newton;
+    no.max_iterations = n->get<int>("max_iterations");
+    no.rtol = n->get<double>("rtol");
+    no.atol = n->get<double>("atol");
+    no.line_search = n->get<bool>("line_search");
+    no.max_line_search = n->get<int>("max_line_search");
+    no.verbose = n->get<bool>("verbose");
+    no.damping = n->get<double>("damping");
+    if (auto dp = n->optional("damping_parts")) {
+      if (!(no.damping > 0)) dp->fail("no damping_parts without damping > 0");
+      if (!dp->is_sequence() || dp->size() == 0) dp->fail("a list of parts out of balloon, artery");
+      for (size_t i = 0; i < dp->size(); ++i) {
+        const std::string part = dp->at(i).as_string();
+        if (!((part == "balloon" && sc.has_balloon) || (part == "artery" && sc.has_artery)))
+          dp->at(i).fail(std::string("a part of this scene (") + (sc.has_balloon ? "balloon" : "") +
+                         (sc.has_balloon && sc.has_artery ? ", " : "") + (sc.has_artery ? "artery" : "") + ")");
+        no.damping_parts.push_back(part);
+      }
+    }
+    no.reuse_preconditioner = n->get<int>("reuse_preconditioner");
+    no.modified = n->get<std::string>("tangent") == "modified";
+    no.max_contraction = n->get<double>("max_contraction");
+    no.continuation = n->get<int>("continuation");
+    if (no.continuation == 1)
+      n->child("continuation").fail("0 (off) or the finest sub-increment as a fraction 1/N, N from 2 to 1024");
+    no.extrapolate = n->get<std::string>("prediction") == "extrapolate";
+    if (n->optional("max_contraction") && !no.modified)
+      n->child("max_contraction")
+          .fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");
+    if (no.modified && no.reuse_preconditioner > 0)
+      n->child("reuse_preconditioner")
+          .fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
+  }
+}
+
 }  // namespace
 
 SolidScene read_solid_scene(const Node& root) {
@@ -328,108 +476,8 @@ SolidScene read_solid_scene(const Node& root) {
   const auto curves = scene::load_curves(root);
   sc.output = scene::output_settings(root);
 
-  if (auto b = root.optional("balloon")) {
-    sc.has_balloon = true;
-    b->check_keys();
-    Axis axis;
-    std::vector<std::string> req;
-    double length = 0;
-    std::optional<geometry::Centerline> curved;
-    Mesh m = read_part_mesh(b->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false, axis,
-                            req, length, curved);
-    for (auto& blk : m.blocks) blk.name = m.blocks.size() == 1 ? "balloon" : "balloon_" + blk.name;
-    const LayerMaterial mat = read_material(b->child("material", "a material {E, nu, fibers}"), "balloon");
-    const int boff = int(sc.mesh.blocks.size());
-    for (size_t i = 0; i < m.blocks.size(); ++i) {
-      LayerMaterial mi = mat;
-      mi.name = m.blocks[i].name;
-      sc.materials.push_back(mi);
-    }
-    (void)boff;
-    if (b->has("pressure"))
-      sc.pressures.push_back(read_pressure(*b, "pressure", "balloon_inner", curves, "balloon_pressure",
-                                           kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
-    if (b->has("end_springs")) {
-      const double k = b->get<double>("end_springs");
-      for (const char* s : {"balloon_end0", "balloon_end1"}) {
-        if (!m.surface(s)) b->child("end_springs").fail("balloon end surfaces (mesh.ends) for the springs");
-        sc.springs.push_back({s, k});
-      }
-    }
-    if (m.node_sets.count("balloon_outer")) {
-      DiameterSpec d;
-      d.node_set = "balloon_outer";
-      d.axis = axis;
-      d.centerline = curved;  // curved balloon: arc-length stations
-      double smin = std::numeric_limits<double>::max(), smax = -smin;
-      for (const auto& x : m.X) {
-        const double s = d.station(x);
-        smin = std::min(smin, s);
-        smax = std::max(smax, s);
-      }
-      double end_offset = std::min(1.7, 0.25 * (smax - smin));
-      if (auto s = b->optional("summary")) {
-        s->check_keys();
-        if (s->has("end_offset")) end_offset = s->get<double>("end_offset");
-        if (!(2 * end_offset < smax - smin))
-          s->child("end_offset").fail("an offset smaller than half the balloon length");
-      }
-      d.s_mid = 0.5 * (smin + smax);
-      d.s_end0 = smin + end_offset;
-      d.s_end1 = smax - end_offset;
-      const int n_spine = curved ? std::max(1, int(std::ceil((smax - smin) / 0.25))) : 1;
-      for (int i = 0; i <= n_spine; ++i) {
-        const double st = smin + (smax - smin) * i / n_spine;
-        sc.balloon_spine.push_back(curved ? Vec3d(curved->point(st)) : Vec3d(axis.origin + st * axis.direction));
-      }
-      sc.balloon_diameter = d;
-    }
-    read_fixed(*b, "balloon_", m, sc.fixed);
-    sc.mesh.append(m);
-  }
-
-  if (auto a = root.optional("artery")) {
-    sc.has_artery = true;
-    a->check_keys();
-    Axis axis;
-    std::vector<std::string> req;
-    double length = 0;
-    std::optional<geometry::Centerline> curved;
-    Mesh m = read_part_mesh(a->child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis, req,
-                            length, curved);
-    const Node layers = a->child("layers", "a map layer name -> material {E, nu, fibers}");
-    if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
-    for (const auto& blk : m.blocks) {
-      if (!layers.has(blk.name)) layers.fail("a material for layer '" + blk.name + "'");
-      sc.materials.push_back(read_material(layers.child(blk.name), blk.name));
-    }
-    for (const auto& k : layers.keys())
-      if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
-    if (a->has("blood_pressure"))
-      sc.pressures.push_back(
-          read_pressure(*a, "blood_pressure", "artery_inner", curves, "blood_pressure", kMaxBloodPressure, "300 mmHg"));
-    if (a->has("end_springs")) {
-      const double k = a->get<double>("end_springs");
-      for (const char* s : {"artery_end0", "artery_end1"}) {
-        if (!m.surface(s)) a->child("end_springs").fail("artery end surfaces (mesh.ends) for the springs");
-        sc.springs.push_back({s, k});
-      }
-    }
-    read_fixed(*a, "artery_", m, sc.fixed);
-    if (m.surface("artery_inner")) {
-      DiameterSpec d;
-      d.node_set = "artery_inner";
-      d.axis = axis;
-      d.centerline = curved;
-      sc.lumen = d;
-    }
-    if (auto s = a->optional("summary")) {
-      s->check_keys();
-      sc.apposition_threshold = s->get<double>("apposition_threshold");
-      sc.lumen_max_stations = s->get<int>("lumen_stations");
-    }
-    sc.mesh.append(m);
-  }
+  if (auto b = root.optional("balloon")) read_balloon(*b, curves, sc);
+  if (auto a = root.optional("artery")) read_artery(*a, curves, sc);
   if (!sc.has_balloon && !sc.has_artery)
     root.fail("a scene with a 'balloon:' and/or 'artery:' section for the solid solver");
   for (size_t i = 0; i < sc.mesh.blocks.size(); ++i)
@@ -437,47 +485,7 @@ SolidScene read_solid_scene(const Node& root) {
       if (sc.mesh.blocks[i].name == sc.mesh.blocks[j].name)
         root.fail("unique block names (balloon and artery both have a block '" + sc.mesh.blocks[i].name + "')");
 
-  if (auto s = root.optional("solid")) {
-    s->check_keys();
-    sc.ranks = s->has("ranks") ? s->get<int>("ranks") : 0;
-    sc.options.partitioner = s->get<std::string>("partitioner");
-    sc.options.petsc_options = s->get<std::string>("petsc_options");
-    if (auto n = s->optional("newton")) {
-      n->check_keys();
-      auto& no = sc.options.newton;
-      no.max_iterations = n->get<int>("max_iterations");
-      no.rtol = n->get<double>("rtol");
-      no.atol = n->get<double>("atol");
-      no.line_search = n->get<bool>("line_search");
-      no.max_line_search = n->get<int>("max_line_search");
-      no.verbose = n->get<bool>("verbose");
-      no.damping = n->get<double>("damping");
-      if (auto dp = n->optional("damping_parts")) {
-        if (!(no.damping > 0)) dp->fail("no damping_parts without damping > 0");
-        if (!dp->is_sequence() || dp->size() == 0) dp->fail("a list of parts out of balloon, artery");
-        for (size_t i = 0; i < dp->size(); ++i) {
-          const std::string part = dp->at(i).as_string();
-          if (!((part == "balloon" && sc.has_balloon) || (part == "artery" && sc.has_artery)))
-            dp->at(i).fail(std::string("a part of this scene (") + (sc.has_balloon ? "balloon" : "") +
-                           (sc.has_balloon && sc.has_artery ? ", " : "") + (sc.has_artery ? "artery" : "") + ")");
-          no.damping_parts.push_back(part);
-        }
-      }
-      no.reuse_preconditioner = n->get<int>("reuse_preconditioner");
-      no.modified = n->get<std::string>("tangent") == "modified";
-      no.max_contraction = n->get<double>("max_contraction");
-      no.continuation = n->get<int>("continuation");
-      if (no.continuation == 1)
-        n->child("continuation").fail("0 (off) or the finest sub-increment as a fraction 1/N, N from 2 to 1024");
-      no.extrapolate = n->get<std::string>("prediction") == "extrapolate";
-      if (n->optional("max_contraction") && !no.modified)
-        n->child("max_contraction")
-            .fail("solid.newton.tangent: modified (max_contraction applies to the modified Newton only)");
-      if (no.modified && no.reuse_preconditioner > 0)
-        n->child("reuse_preconditioner")
-            .fail("0 with tangent: modified (the modified Newton keeps the whole factorization)");
-    }
-  }
+  if (auto s = root.optional("solid")) read_solver_options(*s, sc);
   if (auto s = root.optional("solid"))
     if (auto is = s->optional("initial_state")) read_initial_state(*is, root, sc);
   // The Newton stops at ||r|| <= atol whatever the load; an atol of the order of the loads' own norm
