@@ -116,33 +116,10 @@ std::vector<Vec3> read_points(const Node& n) {
   return pts;
 }
 
-}  // namespace
-
-BeamScene load_beam_scene(const std::string& path) { return beam_scene_from(scene::load_scene(path)); }
-
-BeamScene beam_scene_from(const Node& root) {
-  BeamScene bs;
-  bs.file = root.file();
-  bs.time = scene::time_settings(root);
-  bs.output = scene::output_settings(root);
-  const scene::LoadCurves curves = scene::load_curves(root);
-  const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
-  st.check_keys();
-  bs.model = std::make_unique<BeamModel>();
+// The stent's nodes and elements: stent.generator, stent.lines or stent.nodes/elements; returns the
+// generator's default fixation nodes (the middle ring's bottom crowns).
+std::vector<int> read_geometry(const Node& st, int sec, BeamScene& bs) {
   BeamModel& m = *bs.model;
-  const int sec = m.add_section(read_section(st));
-
-  // element: {residual: consistent | petrov_galerkin} (element.hpp, ResidualForm)
-  if (auto el = st.optional("element")) {
-    el->check_keys();
-    if (el->get<std::string>("residual") == "petrov_galerkin") m.residual_form = ResidualForm::petrov_galerkin;
-  }
-
-  if (auto c = st.optional("contact")) {
-    c->check_keys();
-    m.sample_points_per_element = c->get<int>("points_per_element");
-  }
-
   std::vector<int> fixation_default;
   if (auto g = st.optional("generator")) {
     if (st.has("nodes") || st.has("lines")) st.fail("either generator or nodes/elements/lines, not both");
@@ -213,109 +190,148 @@ BeamScene beam_scene_from(const Node& root) {
       m.add_element(a, b, sec, up);
     }
   }
-  if (m.num_elements() == 0) st.fail("at least one element");
+  return fixation_default;
+}
+
+// fixation w.r.t. the device axis: radial (only radial motion), axial (axial translation
+// fixed), circumferential (circumferential translation fixed). Values: a node list, 'auto'
+// (generator: 4 bottom crowns of the middle ring), 'rings' (4 bottom crowns of every ring).
+void read_fixation(const Node& fx, BeamScene& bs, const std::vector<int>& fixation_default) {
+  BeamModel& m = *bs.model;
   const int nn = m.num_nodes();
-  const int ne = m.num_elements();
+  std::vector<int> ring_fixation;
+  if (bs.stent) ring_fixation = bs.stent->ring_fixation_nodes;
+  fx.check_keys();
+  for (const char* kind : {"radial", "axial", "circumferential"}) {
+    if (!fx.has(kind)) continue;
+    const Node r = fx.child(kind);
+    std::vector<int> nodes;
+    if (r.is_scalar() && (r.as_string() == "auto" || r.as_string() == "rings")) {
+      if (!bs.generated_stent) r.fail("a list of node indices ('auto'/'rings' need the stent generator)");
+      nodes = r.as_string() == "auto" ? fixation_default : ring_fixation;
+    } else if (r.is_scalar() && r.as_string() == "none") {
+    } else {
+      nodes = node_list(fx, kind, nn);
+    }
+    try {
+      for (int n : nodes) {
+        if (std::string(kind) == "radial")
+          m.fix_radial_only(n);
+        else if (std::string(kind) == "axial")
+          m.fix_axial(n);
+        else
+          m.fix_circumferential(n);
+      }
+    } catch (const std::invalid_argument& e) {
+      r.fail(std::string("nodes off the device axis (") + e.what() + ")");
+    }
+  }
+}
+
+// stent.supports: Dirichlet conditions of beam nodes, optionally prescribed along a load curve
+void read_supports(const Node& sup, const scene::LoadCurves& curves, BeamModel& m) {
+  const int nn = m.num_nodes();
+  for (std::size_t i = 0; i < sup.size(); ++i) {
+    const Node s = sup.at(i);
+    s.check_keys();
+    const auto nodes = node_list(s, "nodes", nn);
+    std::array<bool, 6> f{};
+    const Node fix = s.child("fix", "'all' or a list of x, y, z, rx, ry, rz");
+    if (fix.is_scalar()) {
+      if (fix.as_string() != "all") fix.fail("'all' or a list of x, y, z, rx, ry, rz");
+      f.fill(true);
+    } else {
+      static const char* names[6] = {"x", "y", "z", "rx", "ry", "rz"};
+      for (std::size_t k = 0; k < fix.size(); ++k) {
+        const std::string d = fix.at(k).as_string();
+        int idx = -1;
+        for (int q = 0; q < 6; ++q)
+          if (d == names[q]) idx = q;
+        if (idx < 0) fix.at(k).fail("one of x, y, z, rx, ry, rz");
+        f[idx] = true;
+      }
+    }
+    const Curve c = to_curve(scene::curve_ref(s, "curve", curves));
+    for (int n : nodes) {
+      m.fix(n, f);
+      if (s.has("displacement")) {
+        const Vec3 u = v3(s.get<std::array<double, 3>>("displacement"));
+        for (int k = 0; k < 3; ++k)
+          if (u(k) != 0.0) {
+            if (!f[k]) s.child("displacement").fail("non-zero values only on fixed directions");
+            m.prescribed_displacements.push_back({n, k, u(k), c});
+          }
+      }
+      if (s.has("rotation")) {
+        if (!(f[3] && f[4] && f[5])) s.child("rotation").fail("rx, ry and rz all fixed for a prescribed rotation");
+        m.prescribed_rotations.push_back({n, v3(s.get<std::array<double, 3>>("rotation")), c});
+      }
+    }
+  }
+}
+
+// stent.loads: nodal, line and radial line loads along load curves
+void read_loads(const Node& loads, const scene::LoadCurves& curves, BeamModel& m) {
+  const int nn = m.num_nodes(), ne = m.num_elements();
+  for (std::size_t i = 0; i < loads.size(); ++i) {
+    const Node l = loads.at(i);
+    const std::string type = l.get<std::string>("type");
+    const Curve c = to_curve(scene::curve_ref(l, "curve", curves));
+    if (type == "nodal") {
+      l.check_keys({"type", "nodes", "force", "moment", "curve"});
+      Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+      if (l.has("force")) F = v3(l.get<std::array<double, 3>>("force"));
+      if (l.has("moment")) M = v3(l.get<std::array<double, 3>>("moment"));
+      for (int n : node_list(l, "nodes", nn)) m.nodal_loads.push_back({n, F, M, c});
+    } else if (type == "line") {
+      l.check_keys({"type", "elements", "q", "curve"});
+      m.line_loads.push_back({element_list(l, "elements", ne), v3(l.get<std::array<double, 3>>("q")), c});
+    } else {
+      l.check_keys({"type", "elements", "magnitude", "curve", "follower"});
+      m.radial_loads.push_back(
+          {element_list(l, "elements", ne), l.get<double>("magnitude"), c, l.get<bool>("follower")});
+    }
+  }
+}
+
+}  // namespace
+
+BeamScene load_beam_scene(const std::string& path) { return beam_scene_from(scene::load_scene(path)); }
+
+BeamScene beam_scene_from(const Node& root) {
+  BeamScene bs;
+  bs.file = root.file();
+  bs.time = scene::time_settings(root);
+  bs.output = scene::output_settings(root);
+  const scene::LoadCurves curves = scene::load_curves(root);
+  const Node st = root.child("stent", "the beam model (generator or nodes/elements)");
+  st.check_keys();
+  bs.model = std::make_unique<BeamModel>();
+  BeamModel& m = *bs.model;
+  const int sec = m.add_section(read_section(st));
+
+  // element: {residual: consistent | petrov_galerkin} (element.hpp, ResidualForm)
+  if (auto el = st.optional("element")) {
+    el->check_keys();
+    if (el->get<std::string>("residual") == "petrov_galerkin") m.residual_form = ResidualForm::petrov_galerkin;
+  }
+
+  if (auto c = st.optional("contact")) {
+    c->check_keys();
+    m.sample_points_per_element = c->get<int>("points_per_element");
+  }
+
+  const std::vector<int> fixation_default = read_geometry(st, sec, bs);
+  if (m.num_elements() == 0) st.fail("at least one element");
 
   if (auto ax = st.optional("axis")) {
     ax->check_keys();
     m.axis.points = read_points(ax->child("points", "a list of points [x, y, z]"));
   }
 
-  // fixation w.r.t. the device axis: radial (only radial motion), axial (axial translation
-  // fixed), circumferential (circumferential translation fixed). Values: a node list, 'auto'
-  // (generator: 4 bottom crowns of the middle ring), 'rings' (4 bottom crowns of every ring).
-  std::vector<int> ring_fixation;
-  if (bs.stent) ring_fixation = bs.stent->ring_fixation_nodes;
-  if (auto fx = st.optional("fixation")) {
-    fx->check_keys();
-    for (const char* kind : {"radial", "axial", "circumferential"}) {
-      if (!fx->has(kind)) continue;
-      const Node r = fx->child(kind);
-      std::vector<int> nodes;
-      if (r.is_scalar() && (r.as_string() == "auto" || r.as_string() == "rings")) {
-        if (!bs.generated_stent) r.fail("a list of node indices ('auto'/'rings' need the stent generator)");
-        nodes = r.as_string() == "auto" ? fixation_default : ring_fixation;
-      } else if (r.is_scalar() && r.as_string() == "none") {
-      } else {
-        nodes = node_list(*fx, kind, nn);
-      }
-      try {
-        for (int n : nodes) {
-          if (std::string(kind) == "radial")
-            m.fix_radial_only(n);
-          else if (std::string(kind) == "axial")
-            m.fix_axial(n);
-          else
-            m.fix_circumferential(n);
-        }
-      } catch (const std::invalid_argument& e) {
-        r.fail(std::string("nodes off the device axis (") + e.what() + ")");
-      }
-    }
-  }
-
-  if (auto sup = st.optional("supports")) {
-    for (std::size_t i = 0; i < sup->size(); ++i) {
-      const Node s = sup->at(i);
-      s.check_keys();
-      const auto nodes = node_list(s, "nodes", nn);
-      std::array<bool, 6> f{};
-      const Node fix = s.child("fix", "'all' or a list of x, y, z, rx, ry, rz");
-      if (fix.is_scalar()) {
-        if (fix.as_string() != "all") fix.fail("'all' or a list of x, y, z, rx, ry, rz");
-        f.fill(true);
-      } else {
-        static const char* names[6] = {"x", "y", "z", "rx", "ry", "rz"};
-        for (std::size_t k = 0; k < fix.size(); ++k) {
-          const std::string d = fix.at(k).as_string();
-          int idx = -1;
-          for (int q = 0; q < 6; ++q)
-            if (d == names[q]) idx = q;
-          if (idx < 0) fix.at(k).fail("one of x, y, z, rx, ry, rz");
-          f[idx] = true;
-        }
-      }
-      const Curve c = to_curve(scene::curve_ref(s, "curve", curves));
-      for (int n : nodes) {
-        m.fix(n, f);
-        if (s.has("displacement")) {
-          const Vec3 u = v3(s.get<std::array<double, 3>>("displacement"));
-          for (int k = 0; k < 3; ++k)
-            if (u(k) != 0.0) {
-              if (!f[k]) s.child("displacement").fail("non-zero values only on fixed directions");
-              m.prescribed_displacements.push_back({n, k, u(k), c});
-            }
-        }
-        if (s.has("rotation")) {
-          if (!(f[3] && f[4] && f[5])) s.child("rotation").fail("rx, ry and rz all fixed for a prescribed rotation");
-          m.prescribed_rotations.push_back({n, v3(s.get<std::array<double, 3>>("rotation")), c});
-        }
-      }
-    }
-  }
-
-  if (auto loads = st.optional("loads")) {
-    for (std::size_t i = 0; i < loads->size(); ++i) {
-      const Node l = loads->at(i);
-      const std::string type = l.get<std::string>("type");
-      const Curve c = to_curve(scene::curve_ref(l, "curve", curves));
-      if (type == "nodal") {
-        l.check_keys({"type", "nodes", "force", "moment", "curve"});
-        Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-        if (l.has("force")) F = v3(l.get<std::array<double, 3>>("force"));
-        if (l.has("moment")) M = v3(l.get<std::array<double, 3>>("moment"));
-        for (int n : node_list(l, "nodes", nn)) m.nodal_loads.push_back({n, F, M, c});
-      } else if (type == "line") {
-        l.check_keys({"type", "elements", "q", "curve"});
-        m.line_loads.push_back({element_list(l, "elements", ne), v3(l.get<std::array<double, 3>>("q")), c});
-      } else {
-        l.check_keys({"type", "elements", "magnitude", "curve", "follower"});
-        m.radial_loads.push_back(
-            {element_list(l, "elements", ne), l.get<double>("magnitude"), c, l.get<bool>("follower")});
-      }
-    }
-  }
+  if (auto fx = st.optional("fixation")) read_fixation(*fx, bs, fixation_default);
+  if (auto sup = st.optional("supports")) read_supports(*sup, curves, m);
+  if (auto loads = st.optional("loads")) read_loads(*loads, curves, m);
 
   if (auto so = st.optional("solver")) {
     so->check_keys();
