@@ -609,7 +609,7 @@ def run_procedure(scene, scene_path, scene_text, args):
         die(str(e))
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene", help="scene file (YAML)")
     ap.add_argument(
@@ -665,7 +665,109 @@ def main():
         die(f"--timeout: expected a positive number of seconds, got {args.timeout}")
     if args.run_id is not None and not RUN_ID.fullmatch(args.run_id):
         die(f"--run-id: expected 1 to 64 of A-Z a-z 0-9 . _ -, got {shown(args.run_id)}")
+    return args
 
+
+def process_plan(run_dir, run_id, args, exes, solver_scene):
+    """[(name, command)] of the processes to start: coupler, beam and solid for a coupled scene, else
+    the one solver."""
+    beam_exe, solid_exe, coupler_exe = exes
+    common = ["--scene", str(solver_scene), "--run-dir", str(run_dir), "--log-level", args.log_level]
+    if args.timeout is not None:
+        common += ["--timeout", str(args.timeout)]
+    if beam_exe and solid_exe:
+        write_run_key(run_dir / "run.key")
+        endpoint = args.endpoint or pick_endpoint(run_dir, args.transport)
+        coupled = ["--endpoint", endpoint, "--run-id", run_id]
+        coupler = coupler_exe + common + coupled + (["--record"] if args.record else [])
+        return [
+            ("coupler", coupler),
+            ("beam_solver", beam_exe + common + coupled),
+            ("solid_solver", solid_exe + common + coupled),
+        ]
+    if beam_exe:
+        return [("beam_solver", beam_exe + common)]
+    return [("solid_solver", solid_exe + common)]
+
+
+def supervise(plan, run_dir, args):
+    """Starts the processes, forwards Ctrl-C and SIGTERM, stops the others when one fails; the
+    launcher's exit code, and the report of a finished run."""
+    procs = []
+    interrupted = {"sig": None}
+
+    coupler_proc = lambda: next((pr for pr in procs if pr.name == "coupler"), None)  # noqa: E731
+
+    def forward(sig, _frame):
+        # A first Ctrl-C in a coupled run goes to the coupler alone: it finishes the step under way and
+        # shuts the participants down, so every summary is written (mpirun would kill the solid's ranks
+        # on a SIGINT of its own). A second Ctrl-C, or SIGTERM, stops everything now.
+        c = coupler_proc()
+        if sig == signal.SIGINT and interrupted["sig"] is None and c is not None and c.p.poll() is None:
+            interrupted["sig"] = sig
+            interrupted["graceful"] = True
+            print("launch: stopping after the current step (Ctrl-C again to stop now)", file=sys.stderr, flush=True)
+            c.signal(signal.SIGINT)
+            return
+        interrupted["sig"] = sig
+        interrupted["graceful"] = False
+        for pr in procs:
+            pr.signal(signal.SIGINT if sig == signal.SIGINT else signal.SIGTERM)
+
+    signal.signal(signal.SIGINT, forward)
+    signal.signal(signal.SIGTERM, forward)
+    t0 = time.time()
+    for name, cmd in plan:
+        try:
+            echo = args.verbose or len(plan) == 1 or name == "coupler"
+            procs.append(Proc(name, cmd, run_dir / f"{name}.log", echo_all=echo))
+        except OSError as e:
+            stop_all(procs)
+            die(f"cannot start {name} ({' '.join(cmd[:1])}): {e.strerror}", code=10 + len(procs))
+
+    failed = None
+    while True:
+        alive = [pr for pr in procs if pr.p.poll() is None]
+        for pr in procs:
+            rc = pr.p.poll()
+            if rc not in (None, 0) and failed is None and interrupted["sig"] is None:
+                failed = (pr.name, rc)
+        if failed or not alive:
+            break
+        if interrupted["sig"] is not None and not interrupted.get("graceful"):
+            stop_all(procs, grace=10.0)
+            break
+        time.sleep(0.2)
+
+    if failed:
+        stop_all([pr for pr in procs if pr.p.poll() is None])
+    for pr in procs:
+        pr.p.wait()
+        pr.t.join(timeout=2.0)
+    wall = time.time() - t0
+    if interrupted["sig"] is not None:
+        print(f"launch: interrupted after {wall:.1f} s; partial results in {run_dir}", file=sys.stderr)
+        return 130
+    if failed:
+        name, rc = failed
+        why = last_error_line(run_dir / f"{name}.log")
+        print(
+            f"launch: error: {name} exited with code {rc} after {wall:.1f} s{': ' + why if why else ''} "
+            f"(log: {run_dir / (name + '.log')}); the other processes were stopped",
+            file=sys.stderr,
+        )
+        # 2 is every executable's "bad scene or mesh" (the message names the file and key): passed on
+        # unchanged, so that a bad scene is exit code 2 from the launcher as from the solvers
+        return 2 if rc == 2 else 10 + [n for n, _ in plan].index(name)
+    print(f"launch: finished in {wall:.1f} s; results in {run_dir}")
+    report = ROOT / "scripts" / "report.py"
+    if report.is_file():
+        subprocess.call([sys.executable, str(report), str(run_dir)])
+    return 0
+
+
+def main():
+    args = parse_args()
     # One BLAS thread per process: the solid runs one MPI rank per core, and a threaded OpenBLAS under
     # MUMPS would oversubscribe the cores (a user's explicit setting wins).
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
@@ -741,100 +843,11 @@ def main():
             solver_scene = install_prepared(prepared, run_dir)
     except OSError as e:
         die(f"{run_dir}: cannot write the scene: {e.strerror}")
-    common = ["--scene", str(solver_scene), "--run-dir", str(run_dir), "--log-level", args.log_level]
-    if args.timeout is not None:
-        common += ["--timeout", str(args.timeout)]
-
-    plan = []
-    if has_stent and has_solid:
-        write_run_key(run_dir / "run.key")
-        endpoint = args.endpoint or pick_endpoint(run_dir, args.transport)
-        coupled = ["--endpoint", endpoint, "--run-id", run_id]
-        coupler = coupler_exe + common + coupled + (["--record"] if args.record else [])
-        plan = [
-            ("coupler", coupler),
-            ("beam_solver", beam_exe + common + coupled),
-            ("solid_solver", solid_exe + common + coupled),
-        ]
-    elif has_stent:
-        plan = [("beam_solver", beam_exe + common)]
-    else:
-        plan = [("solid_solver", solid_exe + common)]
-
+    plan = process_plan(run_dir, run_id, args, (beam_exe, solid_exe, coupler_exe), solver_scene)
     print(f"launch: run directory {run_dir}")
     via = f" ({ranks} rank{'s' if ranks > 1 else ''} via {mpirun[0]})" if has_solid and not args.solid_cmd else ""
     print("launch: processes: " + ", ".join(name + (via if name == "solid_solver" else "") for name, _ in plan))
-    procs = []
-    interrupted = {"sig": None}
-
-    coupler_proc = lambda: next((pr for pr in procs if pr.name == "coupler"), None)  # noqa: E731
-
-    def forward(sig, _frame):
-        # A first Ctrl-C in a coupled run goes to the coupler alone: it finishes the step under way and
-        # shuts the participants down, so every summary is written (mpirun would kill the solid's ranks
-        # on a SIGINT of its own). A second Ctrl-C, or SIGTERM, stops everything now.
-        c = coupler_proc()
-        if sig == signal.SIGINT and interrupted["sig"] is None and c is not None and c.p.poll() is None:
-            interrupted["sig"] = sig
-            interrupted["graceful"] = True
-            print("launch: stopping after the current step (Ctrl-C again to stop now)", file=sys.stderr, flush=True)
-            c.signal(signal.SIGINT)
-            return
-        interrupted["sig"] = sig
-        interrupted["graceful"] = False
-        for pr in procs:
-            pr.signal(signal.SIGINT if sig == signal.SIGINT else signal.SIGTERM)
-
-    signal.signal(signal.SIGINT, forward)
-    signal.signal(signal.SIGTERM, forward)
-    t0 = time.time()
-    for name, cmd in plan:
-        try:
-            echo = args.verbose or len(plan) == 1 or name == "coupler"
-            procs.append(Proc(name, cmd, run_dir / f"{name}.log", echo_all=echo))
-        except OSError as e:
-            stop_all(procs)
-            die(f"cannot start {name} ({' '.join(cmd[:1])}): {e.strerror}", code=10 + len(procs))
-
-    failed = None
-    while True:
-        alive = [pr for pr in procs if pr.p.poll() is None]
-        for pr in procs:
-            rc = pr.p.poll()
-            if rc not in (None, 0) and failed is None and interrupted["sig"] is None:
-                failed = (pr.name, rc)
-        if failed or not alive:
-            break
-        if interrupted["sig"] is not None and not interrupted.get("graceful"):
-            stop_all(procs, grace=10.0)
-            break
-        time.sleep(0.2)
-
-    if failed:
-        stop_all([pr for pr in procs if pr.p.poll() is None])
-    for pr in procs:
-        pr.p.wait()
-        pr.t.join(timeout=2.0)
-    wall = time.time() - t0
-    if interrupted["sig"] is not None:
-        print(f"launch: interrupted after {wall:.1f} s; partial results in {run_dir}", file=sys.stderr)
-        return 130
-    if failed:
-        name, rc = failed
-        why = last_error_line(run_dir / f"{name}.log")
-        print(
-            f"launch: error: {name} exited with code {rc} after {wall:.1f} s{': ' + why if why else ''} "
-            f"(log: {run_dir / (name + '.log')}); the other processes were stopped",
-            file=sys.stderr,
-        )
-        # 2 is every executable's "bad scene or mesh" (the message names the file and key): passed on
-        # unchanged, so that a bad scene is exit code 2 from the launcher as from the solvers
-        return 2 if rc == 2 else 10 + [n for n, _ in plan].index(name)
-    print(f"launch: finished in {wall:.1f} s; results in {run_dir}")
-    report = ROOT / "scripts" / "report.py"
-    if report.is_file():
-        subprocess.call([sys.executable, str(report), str(run_dir)])
-    return 0
+    return supervise(plan, run_dir, args)
 
 
 if __name__ == "__main__":
