@@ -96,7 +96,6 @@ void check_memory(const Node& mesh, double nodes) {
 // mesh: {generator: tube, ...} or {file: x.msh, ...}; returns the mesh with part-prefixed surfaces.
 // `curved` is set for a generated tube warped onto mesh.centerline (paper §2.4, §3.2).
 Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axis& axis,
-                    std::vector<std::string>& required_surfaces, double& length,
                     std::optional<geometry::Centerline>& curved) {
   const std::string prefix = part + "_";
   if (mesh.has("file")) {
@@ -119,13 +118,6 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     } else {
       set_frames_from_axis(m, axis);
     }
-    double smin = std::numeric_limits<double>::max(), smax = -smin;
-    for (const auto& x : m.X) {
-      const double s = (x - axis.origin).dot(axis.direction);
-      smin = std::min(smin, s);
-      smax = std::max(smax, s);
-    }
-    length = smax - smin;
     // rename the named surfaces to the canonical names used by the loads
     auto rename = [&](const std::string& key, const std::string& canonical) {
       const std::string given = prefix + mesh.get<std::string>(key);
@@ -158,7 +150,6 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
         if (!found) ends.at(i).fail("the name of a surface physical group in " + path);
       }
     }
-    (void)required_surfaces;
     return m;
   }
   mesh.check_keys(layered
@@ -231,7 +222,6 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     mesh.child("start").fail("no 'start' without a 'centerline'");
   }
   axis = Axis{t.center, Vec3d::UnitZ()};
-  length = t.length;
   check_memory(mesh, double(t.n_circ) * (t.n_axial + 1.0) * (shells(t) + 1.0));
   try {
     return make_tube(t);
@@ -320,35 +310,35 @@ void read_initial_state(const Node& is, const Node& root, SolidScene& sc) {
   sc.initial_parts = std::move(parts);
 }
 
+// end_springs of a part (balloon, artery): one spring per unit area on each end face (mesh.ends)
+void read_end_springs(const Node& part_node, const std::string& part, const Mesh& m, SolidScene& sc) {
+  if (!part_node.has("end_springs")) return;
+  const double k = part_node.get<double>("end_springs");
+  for (const std::string& s : {part + "_end0", part + "_end1"}) {
+    if (!m.surface(s)) part_node.child("end_springs").fail(part + " end surfaces (mesh.ends) for the springs");
+    sc.springs.push_back({s, k});
+  }
+}
+
 // balloon: {mesh, material, pressure, end_springs, summary, fixed}
 void read_balloon(const Node& b, const scene::LoadCurves& curves, SolidScene& sc) {
   sc.has_balloon = true;
   b.check_keys();
   Axis axis;
-  std::vector<std::string> req;
-  double length = 0;
   std::optional<geometry::Centerline> curved;
-  Mesh m = read_part_mesh(b.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false, axis, req,
-                          length, curved);
+  Mesh m =
+      read_part_mesh(b.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "balloon", false, axis, curved);
   for (auto& blk : m.blocks) blk.name = m.blocks.size() == 1 ? "balloon" : "balloon_" + blk.name;
   const LayerMaterial mat = read_material(b.child("material", "a material {E, nu, fibers}"), "balloon");
-  const int boff = int(sc.mesh.blocks.size());
   for (size_t i = 0; i < m.blocks.size(); ++i) {
     LayerMaterial mi = mat;
     mi.name = m.blocks[i].name;
     sc.materials.push_back(mi);
   }
-  (void)boff;
   if (b.has("pressure"))
     sc.pressures.push_back(read_pressure(b, "pressure", "balloon_inner", curves, "balloon_pressure",
                                          kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
-  if (b.has("end_springs")) {
-    const double k = b.get<double>("end_springs");
-    for (const char* s : {"balloon_end0", "balloon_end1"}) {
-      if (!m.surface(s)) b.child("end_springs").fail("balloon end surfaces (mesh.ends) for the springs");
-      sc.springs.push_back({s, k});
-    }
-  }
+  read_end_springs(b, "balloon", m, sc);
   if (m.node_sets.count("balloon_outer")) {
     DiameterSpec d;
     d.node_set = "balloon_outer";
@@ -386,11 +376,9 @@ void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc)
   sc.has_artery = true;
   a.check_keys();
   Axis axis;
-  std::vector<std::string> req;
-  double length = 0;
   std::optional<geometry::Centerline> curved;
-  Mesh m = read_part_mesh(a.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis, req,
-                          length, curved);
+  Mesh m =
+      read_part_mesh(a.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis, curved);
   const Node layers = a.child("layers", "a map layer name -> material {E, nu, fibers}");
   if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
   for (const auto& blk : m.blocks) {
@@ -402,13 +390,7 @@ void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc)
   if (a.has("blood_pressure"))
     sc.pressures.push_back(
         read_pressure(a, "blood_pressure", "artery_inner", curves, "blood_pressure", kMaxBloodPressure, "300 mmHg"));
-  if (a.has("end_springs")) {
-    const double k = a.get<double>("end_springs");
-    for (const char* s : {"artery_end0", "artery_end1"}) {
-      if (!m.surface(s)) a.child("end_springs").fail("artery end surfaces (mesh.ends) for the springs");
-      sc.springs.push_back({s, k});
-    }
-  }
+  read_end_springs(a, "artery", m, sc);
   read_fixed(a, "artery_", m, sc.fixed);
   if (m.surface("artery_inner")) {
     DiameterSpec d;
