@@ -19,6 +19,13 @@ patient scene the pipeline places the stent and the scene's balloon at the steno
 phase's balloon on the same device centerline), not on the deformed lumen's centerline: right for
 straight and gently curved vessels, whose axis a dilatation hardly moves.
 
+A phase whose crimped devices (its balloon; the stent in the phase that deploys it) are wider than
+the lumen under them plus `procedure[k].insertion.clearance` opens the lumen first with the virtual
+insertion tool (insertion_tool.py, `mode: auto`, the default): the lumen is the one the phase
+starts from (the end of the phase before; for the first phase the reference mesh's, measured by
+the solid alone in <run>/0-lumen/), and the tool works while the phase's balloon pressure is still
+0 at its start (the pressure curve must leave that time: an error naming the curve otherwise).
+
 After the last phase (or a failed one) <run>/procedure.json holds per phase: status, wall time,
 steps, and the quantities interventional studies report (minimal lumen diameter and area at the
 phase's peak balloon pressure and at its end, lumen gain against the lumen before the procedure,
@@ -37,6 +44,7 @@ from pathlib import Path
 
 import yaml
 
+import insertion_tool
 import scene_keys
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -119,8 +127,20 @@ def phases(scene, path):
                 f"{path}: {where}: expected a balloon within the artery (axially {-half:g} to {half:g} mm "
                 f"from its centre), got {ext[0]:g} to {ext[1]:g} mm"
             )
+        insertion = scene_keys.check_map(
+            ph.get("insertion", {}), f"{key}.insertion", path, ProcedureError
+        )  # declared defaults: mode auto
         out.append(
-            {"name": name, "start": float(start), "end": float(end), "steps": steps, "balloon": balloon, "stent": stent}
+            {
+                "name": name,
+                "start": float(start),
+                "end": float(end),
+                "steps": steps,
+                "balloon": balloon,
+                "stent": stent,
+                "new_stent": stent and not stent_on,
+                "insertion": insertion,
+            }
         )
         start, stent_on = end, stent
     return out
@@ -132,6 +152,11 @@ def complete(scene, path, out_dir, log=print):
     at the stenosis, the virtual insertion where the lesion is narrower than the devices), and each
     phase's own balloon placed on the same device centerline, centred where the scene's balloon is.
     Other scenes are returned unchanged. Raises ProcedureError naming the key."""
+    if insertion_tool.CURVE in (scene.get("load_curves") or {}):
+        raise ProcedureError(
+            f"{path}: load_curves.{insertion_tool.CURVE}: expected no curve of this name (the procedure "
+            "writes the virtual insertion tool's radius under it)"
+        )
     if "patient" not in scene:
         return scene
     sys.path.insert(0, str(ROOT / "scripts"))
@@ -175,10 +200,25 @@ def complete(scene, path, out_dir, log=print):
     return done
 
 
-def phase_scene(scene, phase, previous=None):
+def _own_tool(scene):
+    """The scene's contact.insertion when it is the user's own (not one the pipeline or the procedure
+    wrote under insertion_tool.CURVE), else None."""
+    ins = (scene.get("contact") or {}).get("insertion")
+    if not isinstance(ins, dict):
+        return None
+    r = ins.get("radius")
+    return None if isinstance(r, dict) and r.get("curve") == insertion_tool.CURVE else ins
+
+
+def phase_scene(scene, phase, previous=None, tool=None):
     """The scene of one phase (a dict): the phase's time window, devices and contacts; `previous` =
-    (run dir of the phase before, whether it had the stent): the states it continues from."""
+    (run dir of the phase before, whether it had the stent): the states it continues from; `tool`:
+    the phase's virtual insertion (insertion_plan), if any. The patient pipeline's tool belongs to
+    the first phase."""
     s = copy.deepcopy({k: v for k, v in scene.items() if k != "procedure"})
+    if previous is not None and isinstance(s.get("contact"), dict) and not _own_tool(s):
+        s["contact"].pop("insertion", None)
+        (s.get("load_curves") or {}).pop(insertion_tool.CURVE, None)
     s["time"] = {**(scene.get("time") or {}), "start": phase["start"], "end": phase["end"], "steps": phase["steps"]}
     if phase["balloon"] is not None:
         s["balloon"] = copy.deepcopy(phase["balloon"])
@@ -197,7 +237,115 @@ def phase_scene(scene, phase, previous=None):
         }
         if prev_stent:
             s["stent"]["initial_state"] = {"file": str(Path(prev_dir) / "beam" / "state.h5")}
+    if tool is not None:
+        insertion_tool.add_tool(s, tool["t0"], tool["t1"], tool["r0"], tool["r_open"], tool["penalty"])
     return s
+
+
+# --- the virtual insertion of a phase whose devices are wider than the lumen --------------------
+
+
+def device_radius(scene, phase):
+    """The outer radius of the phase's crimped devices (mm): its balloon, and the stent where the
+    phase deploys it (crimped diameter / 2 + the strut's contact radius)."""
+    r = 0.5 * float(phase["balloon"]["mesh"]["outer_diameter"])
+    if phase["new_stent"]:
+        g, sec = scene["stent"].get("generator") or {}, scene["stent"].get("section") or {}
+        crimped = g.get("crimped_diameter", scene_keys.default("stent.generator.crimped_diameter"))
+        r = max(r, 0.5 * float(crimped) + float(sec.get("contact_radius", sec.get("radius", 0.0))))
+    return r
+
+
+def pressure_free_until(scene, phase):
+    """The last time from the phase's start on during which its balloon's pressure is still 0."""
+    p = phase["balloon"].get("pressure")
+    if isinstance(p, dict) and isinstance(p.get("curve"), str):
+        points = (scene.get("load_curves") or {}).get(p["curve"])
+        if points and float(p.get("value", 1.0)) != 0.0:
+            return min(insertion_tool.quiet_until(points, phase["start"]), phase["end"])
+    return phase["end"] if p in (None, 0, 0.0) else phase["start"]
+
+
+def insertion_plan(scene, phase, k, lumen, path):
+    """The phase's virtual insertion {t0, t1, r0, r_open, penalty, lumen_diameter, device_radius}, or
+    None when its devices fit (or it has no balloon, or the scene brings its own tool). `lumen`: the
+    minimal lumen diameter (mm) under the phase's balloon at the phase's start. Raises ProcedureError
+    when the devices do not fit and the tool cannot work (insertion off, or no pressure-free time)."""
+    ins = phase["insertion"]
+    # with the stent in place from an earlier phase the balloon goes inside it, where the tool
+    # (which pushes the artery only) has nothing to open
+    if phase["balloon"] is None or lumen is None or _own_tool(scene) or (phase["stent"] and not phase["new_stent"]):
+        return None
+    R = device_radius(scene, phase)
+    if 0.5 * lumen >= R + ins["clearance"]:
+        return None
+    key = f"procedure[{k}]"
+    tight = (
+        f"the lumen the phase starts from ({lumen:.3f} mm at its narrowest under the balloon) is narrower than its "
+        f"crimped devices (outer diameter {2 * R:.3f} mm) plus twice {key}.insertion.clearance "
+        f"({ins['clearance']:g} mm)"
+    )
+    if ins["mode"] == "off":
+        raise ProcedureError(f"{path}: {key}.insertion.mode: expected auto (the virtual insertion), got off: {tight}")
+    t0, t1 = phase["start"], pressure_free_until(scene, phase)
+    dt = (phase["end"] - phase["start"]) / phase["steps"]
+    if t1 - t0 < 4 * dt - 1e-12:
+        curve = (phase["balloon"].get("pressure") or {}).get("curve", "?")
+        raise ProcedureError(
+            f"{path}: load_curves.{curve}: expected no balloon pressure for at least 4 load steps "
+            f"({4 * dt:g} s) from the start of phase {k + 1} ({phase['name']}, t = {t0:g} s), in which the "
+            f"virtual insertion opens the lumen; got {max(t1 - t0, 0.0):g} s: {tight}"
+        )
+    return {
+        "t0": t0,
+        "t1": t1,
+        "r0": insertion_tool.START_FRACTION * 0.5 * lumen,
+        "r_open": R + ins["clearance"],
+        "penalty": ins["penalty"],
+        "lumen_diameter": lumen,
+        "device_radius": R,
+    }
+
+
+def lumen_under(summary, step, scene, phase):
+    """The minimal lumen diameter (mm) under the phase's balloon at one step of a solid summary
+    (all stations where the balloon's extent along them is not known); None without a lumen."""
+    stations = summary.get("lumen_stations") or []
+    d = step.get("lumen_diameter") or []
+    ext = balloon_extent(phase["balloon"], scene["artery"]) if phase["balloon"] is not None else None
+    mask = [ext[0] <= z <= ext[1] for z in stations] if ext and len(stations) == len(d) else None
+    if mask is not None and not any(mask):
+        mask = None
+    return _lumen_min(step, mask)
+
+
+def reference_lumen(scene, phase, run_dir, launch_args):
+    """The solid summary of the artery alone at the procedure's start (the reference mesh's lumen):
+    one tiny step of the solid, in <run_dir>/0-lumen/."""
+    s = phase_scene(scene, phase)
+    for k in ("balloon", "stent", "contact", "coupling"):
+        s.pop(k, None)
+    s["time"] = {**s["time"], "end": phase["start"] + 1e-6 * (phase["end"] - phase["start"]), "steps": 1}
+    s.setdefault("solid", {})["ranks"] = 1
+    for k in ("damping", "damping_parts"):  # the balloon's pseudo-time damping: no balloon here
+        (s["solid"].get("newton") or {}).pop(k, None)
+    s["output"] = {**(s.get("output") or {}), "every": 1}
+    f = Path(run_dir) / "0-lumen.yaml"
+    _write(f, s, "the artery alone at the procedure's start: its lumen decides the first phase's insertion")
+    args, skip = [], False
+    for a in launch_args:  # one rank whatever the procedure's --ranks
+        if skip or a == "--ranks":
+            skip = a == "--ranks"
+            continue
+        args.append(a)
+    rc = subprocess.call(
+        [sys.executable, str(LAUNCH), str(f), "--run-dir", str(Path(run_dir) / "0-lumen")] + args,
+        stdout=subprocess.DEVNULL,
+    )
+    summary = _load(Path(run_dir) / "0-lumen" / "solid" / "summary.json")
+    if rc != 0 or not summary or not summary.get("steps"):
+        raise ProcedureError(f"{f}: the artery alone did not start (exit {rc}); see {Path(run_dir) / '0-lumen'}")
+    return summary, summary["steps"][0]
 
 
 def phase_dir(run_dir, k, phase):
@@ -339,18 +487,21 @@ def phase_results(pdir, phase, before, stations, mask):
     return out
 
 
-def summarize(run_dir, scene, path, ran):
-    """procedure.json and lumen_profiles.png from the phases that ran: [(k, phase, status, wall)]."""
+def summarize(run_dir, scene, path, ran, tools=None):
+    """procedure.json and lumen_profiles.png from the phases that ran: [(k, phase, status, wall)];
+    tools: the virtual insertion of a phase by name (insertion_plan)."""
     run_dir = Path(run_dir)
     first = _load(phase_dir(run_dir, 0, ran[0][1]) / "solid" / "summary.json") if ran else None
     stations = (first or {}).get("lumen_stations") or []
     if isinstance(stations, int):
         stations = []
     steps0 = [s for s in (first or {}).get("steps", []) if _number(s.get("time"))]
-    # before the procedure: the last step before the first balloon pressure (the prestressed lumen)
+    # before the procedure: the last step before the first balloon pressure (the prestressed lumen);
+    # where the first phase opened the lesion with the insertion tool, the lumen before the tool
+    tool0 = (tools or {}).get(ran[0][1]["name"]) if ran else None
     before = steps0[0] if steps0 else {}
     for s in steps0:
-        if (s.get("balloon_pressure") or 0.0) > 0.0:
+        if (s.get("balloon_pressure") or 0.0) > 0.0 or (tool0 and s["time"] > tool0["t0"]):
             break
         before = s
     out = {
@@ -377,6 +528,8 @@ def summarize(run_dir, scene, path, ran):
     for k, ph, status, wall in ran:
         r = phase_results(phase_dir(run_dir, k, ph), ph, before, stations, mask)
         r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
+        if (tools or {}).get(ph["name"]):
+            r["insertion"] = {x: v for x, v in tools[ph["name"]].items() if x != "penalty"}
         out["phases"].append(r)
     (run_dir / "procedure.json").write_text(json.dumps(out, indent=1) + "\n")
     try:
@@ -408,17 +561,39 @@ def run(scene, path, run_dir, launch_args):
     run_dir = Path(run_dir)
     scene = complete(scene, path, run_dir / "geometry")  # a patient procedure: meshed and placed again here
     ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
-    ran, previous, code = [], None, 0
+    ran, previous, code, tools = [], None, 0, {}
     for k, phase in enumerate(ph):
         pdir = phase_dir(run_dir, k, phase)
         scene_file = run_dir / f"{k + 1}-{phase['name']}.yaml"
-        _write(scene_file, phase_scene(scene, phase, previous), f"phase {k + 1} ({phase['name']}) of {path}")
+        t0 = clock.time()
+        try:
+            tool = None
+            needs_lumen = phase["balloon"] is not None and not _own_tool(scene) and phase["stent"] <= phase["new_stent"]
+            if needs_lumen and (previous is not None or "insertion" not in (scene.get("contact") or {})):
+                if previous is None:
+                    summary, step = reference_lumen(scene, phase, run_dir, launch_args)
+                else:
+                    summary = _load(previous[0] / "solid" / "summary.json") or {}
+                    step = (summary.get("steps") or [{}])[-1]
+                tool = insertion_plan(scene, phase, k, lumen_under(summary, step, scene, phase), path)
+        except ProcedureError as e:
+            print(f"procedure: phase {k + 1} ({phase['name']}) not started: {e}", file=sys.stderr)
+            ran.append((k, phase, "not started (exit 2)", clock.time() - t0))
+            code = 2
+            break
+        _write(scene_file, phase_scene(scene, phase, previous, tool), f"phase {k + 1} ({phase['name']}) of {path}")
+        note = ""
+        if tool is not None:
+            tools[phase["name"]] = tool
+            note = (
+                f", virtual insertion (lumen {tool['lumen_diameter']:.3f} mm, devices {2 * tool['device_radius']:.3f}"
+                f" mm: the tool opens to {2 * tool['r_open']:.3f} mm until t = {tool['t1']:g} s)"
+            )
         print(
             f"procedure: phase {k + 1}/{len(ph)} {phase['name']}: t = {phase['start']} .. {phase['end']} s, "
-            f"{phase['steps']} steps{', stent' if phase['stent'] else ''}",
+            f"{phase['steps']} steps{', stent' if phase['stent'] else ''}{note}",
             flush=True,
         )
-        t0 = clock.time()
         rc = subprocess.call([sys.executable, str(LAUNCH), str(scene_file), "--run-dir", str(pdir)] + launch_args)
         ran.append((k, phase, "ok" if rc == 0 else f"failed (exit {rc})", clock.time() - t0))
         if rc != 0:
@@ -426,7 +601,7 @@ def run(scene, path, run_dir, launch_args):
             code = rc
             break
         previous = (pdir, phase["stent"])
-    out = summarize(run_dir, scene, path, ran)
+    out = summarize(run_dir, scene, path, ran, tools)
     for r in out["phases"]:
         lum = r.get("lumen") or {}
         fmt = lambda v: f"{v:.3f}" if _number(v) else "-"  # noqa: E731

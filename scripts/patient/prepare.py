@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import insertion_tool
 import scene_keys
 
 from .artery_mesh import WallSpec, build_artery, layer_radii
@@ -29,13 +30,9 @@ from .placement import Device, devices_fit, place_device, stenosis_site
 
 # The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
 # and checked by scene_keys.check_map.
-# A lesion narrower than a crimped device: a rigid capsule along the balloon axis (contact.insertion)
-# opens the lumen to the devices' outer radius plus `clearance` during the blood-pressure phase, the
-# stent- and balloon-artery contacts switch on once it is open, and it retracts by t = 0 so that the
-# wall comes to rest on the devices (as catheter insertion is modelled by Zahedmanesh, Kelly and Lally,
-# J Biomech 43 (2010) 2126, and Mortier et al., Ann Biomed Eng 38 (2010) 88). clearance 0.065 mm and
-# penalty 300 N/mm^3 (patient.insertion): configs/stability/severe_stenosis_insertion.yaml runs with them.
-INSERTION_CURVE = "insertion_tool"
+# A lesion narrower than a crimped device is opened by the virtual insertion tool (insertion_tool.py)
+# during the blood-pressure phase, before t = 0; clearance 0.065 mm and penalty 300 N/mm^3
+# (patient.insertion): configs/stability/severe_stenosis_insertion.yaml runs with them.
 
 
 def _section(scene, path, scene_path, what):
@@ -105,12 +102,6 @@ def device_of(scene, scene_path):
     )
 
 
-def _curve_value(points, t):
-    ts = [float(p[0]) for p in points]
-    vs = [float(p[1]) for p in points]
-    return float(np.interp(t, ts, vs))
-
-
 def add_insertion(done, plc, dev, ins, scene_path):
     """Completes `done` with the virtual insertion of a lesion narrower than the devices: the tool's
     radius curve, contact.insertion and the artery contacts' switch-on time. Returns its report."""
@@ -128,8 +119,7 @@ def add_insertion(done, plc, dev, ins, scene_path):
     curves = done.get("load_curves") or {}
     bp = done.get("balloon", {}).get("pressure", {})
     bcurve = curves.get(bp.get("curve")) if isinstance(bp, dict) else None
-    probe = [start, 0.0] + [float(q[0]) for q in (bcurve or []) if start < float(q[0]) < 0.0]
-    if bcurve and any(abs(_curve_value(bcurve, t)) > 0 for t in probe):
+    if bcurve and insertion_tool.quiet_until(bcurve, start) < 0.0:
         raise PatientInputError(
             f"{scene_path}: load_curves.{bp.get('curve')}: expected no balloon pressure before "
             f"t = 0 (the virtual insertion opens the lumen then): {tight}"
@@ -137,32 +127,15 @@ def add_insertion(done, plc, dev, ins, scene_path):
     contact = done.setdefault("contact", {})
     if "insertion" in contact:  # the scene's own tool
         return {"tool": "the scene's contact.insertion"}
-    if INSERTION_CURVE in curves:
+    if insertion_tool.CURVE in curves:
         raise PatientInputError(
-            f"{scene_path}: load_curves.{INSERTION_CURVE}: expected no curve of this name "
+            f"{scene_path}: load_curves.{insertion_tool.CURVE}: expected no curve of this name "
             f"(the patient pipeline writes the insertion tool's radius under it)"
         )
-    r0 = 0.9 * plc.axis_clearance  # inside the lumen everywhere along the axis
+    r0 = insertion_tool.START_FRACTION * plc.axis_clearance  # inside the lumen everywhere along the axis
     r_open = max(dev.stent_radius, dev.balloon_radius) + ins["clearance"]
-    T = -float(start)
-    t_open, t_on, t_hold = start + 0.5 * T, start + 0.55 * T, start + 0.6 * T
-    pts = [[float(start), r0], [t_open, r_open], [t_hold, r_open], [0.0, 0.0]]
-    if isinstance(end, (int, float)) and end > 0:
-        pts.append([float(end), 0.0])
-    curves[INSERTION_CURVE] = [[round(t, 9), round(v, 9)] for t, v in pts]
-    done["load_curves"] = curves
-    contact["insertion"] = {
-        "axis": "balloon",
-        "radius": {"value": 1.0, "curve": INSERTION_CURVE},
-        "penalty": ins["penalty"],
-    }
-    on = {}
-    for key in ("stent_artery", "balloon_artery"):
-        c = contact.get(key)
-        if isinstance(c, dict) and "from" not in c:
-            c["from"] = round(t_on, 9)
-            on[key] = c["from"]
-    return {"tool_radius_curve": curves[INSERTION_CURVE], "penalty": ins["penalty"], "contacts_from": on}
+    t_end = end if isinstance(end, (int, float)) and end > 0 else None
+    return insertion_tool.add_tool(done, float(start), 0.0, r0, r_open, ins["penalty"], t_end=t_end)
 
 
 def _write_points(path, pts, comment):

@@ -97,7 +97,7 @@ class SceneKeys(unittest.TestCase):
 
     def test_the_tools_read_the_declarations(self):
         self.assertEqual(launch.SECTIONS, tuple(scene_keys.children("")))
-        self.assertEqual(procedure.PHASE_KEYS, ("name", "end", "steps", "balloon", "stent"))
+        self.assertEqual(procedure.PHASE_KEYS, ("name", "end", "steps", "balloon", "stent", "insertion"))
         self.assertEqual(set(scene_keys.declared("patient.lumen_surface.units").values), set(UNITS))
         # device_of sizes the crimped stent with the generator's declared defaults (it once assumed 6
         # rings where the beam solver generated 4): (rings - 1) x pitch + strut height
