@@ -44,7 +44,10 @@ class CurveWindow(unittest.TestCase):
         s = {"contact": {"stent_artery": {"penalty": 10.0}, "balloon_artery": {"penalty": 5.0, "from": 1.9}}}
         rep = insertion_tool.add_tool(s, 1.0, 2.0, 0.3, 0.7, 300.0)
         self.assertEqual(s["load_curves"]["insertion_tool"], [[1.0, 0.3], [1.5, 0.7], [1.6, 0.7], [2.0, 0.0]])
-        self.assertEqual(s["contact"]["insertion"], {"axis": "balloon", "radius": {"value": 1.0, "curve": "insertion_tool"}, "penalty": 300.0})
+        self.assertEqual(
+            s["contact"]["insertion"],
+            {"axis": "balloon", "radius": {"value": 1.0, "curve": "insertion_tool"}, "penalty": 300.0},
+        )
         self.assertEqual(s["contact"]["stent_artery"]["from"], 1.55)  # on once the tool is open
         self.assertEqual(s["contact"]["balloon_artery"]["from"], 1.9)  # the scene's later switch-on kept
         self.assertEqual(rep["contacts_from"], {"stent_artery": 1.55, "balloon_artery": 1.9})
@@ -105,7 +108,9 @@ class Plan(unittest.TestCase):
     def test_bad_insertion_keys_are_named(self):
         s = tiny()
         s["procedure"][0]["insertion"] = {"clearence": 0.1}
-        with self.assertRaisesRegex(procedure.ProcedureError, r"procedure\[0\]\.insertion\.clearence: unknown key.*clearance"):
+        with self.assertRaisesRegex(
+            procedure.ProcedureError, r"procedure\[0\]\.insertion\.clearence: unknown key.*clearance"
+        ):
             self.phases(s)
         s["procedure"][0]["insertion"] = {"clearance": -1}
         with self.assertRaisesRegex(procedure.ProcedureError, r"procedure\[0\]\.insertion\.clearance: expected"):
