@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent
 KEYS_FILE = ROOT / "core" / "scene" / "keys.yaml"
 REFERENCE = ROOT / "docs" / "scene-keys.md"
 TYPES = ("number", "integer", "boolean", "string", "point", "numbers", "map", "list", "any")
-FIELDS = ("type", "unit", "default", "default_text", "range", "values", "doc", "optional")
+FIELDS = ("type", "unit", "default", "default_text", "range", "values", "doc", "optional", "peak")
 INTERVAL = re.compile(r"^([\[(])\s*(-?inf|[-+0-9.eE]+)\s*,\s*(-?inf|[-+0-9.eE]+)\s*([\])])$")
 INT_MAX = 2**31 - 1
 
@@ -59,6 +59,7 @@ class Decl:
     range_text: str = ""
     values: tuple = ()
     optional: bool = False
+    peak: tuple = None  # (max, why): the plausible peak of a {value, curve} load, in the key's unit
     segments: tuple = field(default=(), repr=False)
 
     @property
@@ -99,6 +100,11 @@ def _decl(path, spec):
     )
     if "range" in spec:
         d.range = _interval(spec["range"], path)
+    if "peak" in spec:
+        pk = spec["peak"]
+        if not (isinstance(pk, dict) and set(pk) == {"max", "why"} and isinstance(pk["max"], (int, float))):
+            raise KeysFileError(f"{where}.peak: expected {{max: a number, why: the reason}}, got {pk!r}")
+        d.peak = (float(pk["max"]), str(pk["why"]))
     if d.has_default and d.default is not None and not _valid(d, d.default):
         raise KeysFileError(f"{where}.default: {d.default!r} is not {expected(d)}")
     return d
@@ -272,6 +278,8 @@ def _range_cell(d):
         cells.append(d.range_text.replace("inf", "∞"))
     if d.values:
         cells.append(" \\| ".join(f"`{v}`" for v in d.values))
+    if d.peak:
+        cells.append(f"peak ≤ {d.peak[0]:g} {d.unit} ({d.peak[1]})")
     return "; ".join(cells)
 
 
@@ -328,7 +336,7 @@ def cpp_name(path):
 
 
 def cpp_header():
-    rows, consts, names = [], [], set()
+    rows, consts, peaks, names = [], [], [], set()
     for d in declarations().values():
         r = d.range or Interval(-math.inf, math.inf, False, False)
         dnum, dstr = 0.0, ""
@@ -360,6 +368,11 @@ def cpp_header():
             )
             + "},"
         )
+        if d.peak:
+            peaks += [
+                f"inline constexpr double {cpp_name(d.path)} = {_cpp_double(d.peak[0])};",
+                f"inline constexpr const char* {cpp_name(d.path)}_why = {_cpp_string(d.peak[1])};",
+            ]
         scalar = len(d.types) == 1 and d.types[0] in ("number", "integer", "boolean", "string")
         if d.has_default and scalar:
             name = cpp_name(d.path)
@@ -412,6 +425,11 @@ def cpp_header():
             "namespace defaults {",
             *consts,
             "}  // namespace defaults",
+            "",
+            "// The plausible peaks (value x load curve, in the key's unit) of the loads that declare one, and why.",
+            "namespace peaks {",
+            *peaks,
+            "}  // namespace peaks",
             "",
             "}  // namespace angio::scene::keys",
             "",

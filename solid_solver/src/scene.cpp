@@ -230,12 +230,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   }
 }
 
-// Plausible peaks (MPa) of the pressure loads: a value above them is a unit or typing error (kPa or
-// mmHg taken for MPa), which would otherwise run until a solver fails. Balloon: 4 MPa ≈ 39.5 atm,
-// above the rated burst pressure of non-compliant post-dilatation balloons (about 20–30 atm).
-// Blood: 0.04 MPa = 300 mmHg, above any physiological or hypertensive crisis pressure.
-constexpr double kMaxBalloonPressure = 4.0, kMaxBloodPressure = 0.04;
-
+// The peak of value x load curve is checked against the key's declared plausible peak (keys.yaml).
 PressureSpec read_pressure(const Node& parent, const std::string& key, const std::string& surface,
                            const scene::LoadCurves& curves, const std::string& label, double max_peak,
                            const char* limit_reason) {
@@ -337,7 +332,8 @@ void read_balloon(const Node& b, const scene::LoadCurves& curves, SolidScene& sc
   }
   if (b.has("pressure"))
     sc.pressures.push_back(read_pressure(b, "pressure", "balloon_inner", curves, "balloon_pressure",
-                                         kMaxBalloonPressure, "39.5 atm, above a balloon's burst pressure"));
+                                         scene::keys::peaks::balloon_pressure,
+                                         scene::keys::peaks::balloon_pressure_why));
   read_end_springs(b, "balloon", m, sc);
   if (m.node_sets.count("balloon_outer")) {
     DiameterSpec d;
@@ -388,8 +384,9 @@ void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc)
   for (const auto& k : layers.keys())
     if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
   if (a.has("blood_pressure"))
-    sc.pressures.push_back(
-        read_pressure(a, "blood_pressure", "artery_inner", curves, "blood_pressure", kMaxBloodPressure, "300 mmHg"));
+    sc.pressures.push_back(read_pressure(a, "blood_pressure", "artery_inner", curves, "blood_pressure",
+                                         scene::keys::peaks::artery_blood_pressure,
+                                         scene::keys::peaks::artery_blood_pressure_why));
   read_end_springs(a, "artery", m, sc);
   read_fixed(a, "artery_", m, sc.fixed);
   if (m.surface("artery_inner")) {
