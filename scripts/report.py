@@ -254,17 +254,13 @@ def read_apposition_csv(path):
     }
 
 
-def artery_report(run, scene, solid, beam, with_paper):
-    """Table rows (stent rows, artery rows), the results.json "artery" section and the plot data of an
-    artery scene."""
-    rows, stent_rows = [], []
-    P = (PAPER_PATIENT if (run / "geometry" / "placement.json").is_file() else PAPER_ARTERY) if with_paper else {}
-    pstress = P.get("stress", {})
-    steps = [s for s in (get(solid, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
-    beam_steps = [s for s in (get(beam, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
-    layers = artery_layers(solid, scene)
-    innermost = layers[0] if layers else None
+def _g(v):
+    """v formatted with :g, or "-" for None."""
+    return "-" if v is None else f"{v:g}"
 
+
+def _artery_phases(steps, beam, beam_steps):
+    """(step per phase, time per phase, how the peak was found) of an artery scene."""
     # phases
     ph = {k: None for k in PHASES}
     times = {k: None for k in PHASES}
@@ -288,20 +284,17 @@ def artery_report(run, scene, solid, beam, with_paper):
     for k in PHASES:
         if ph[k] is not None:
             times[k] = ph[k]["time"]
+    return ph, times, peak_source
 
-    section = {
-        "units": {"length": "mm", "stress": "MPa", "force": "N", "pressure": "MPa", "time": "s"},
-        "layers": layers,
-        "innermost_layer": innermost,
-        "paper": P or None,
-        "phase_definitions": {
-            "prestressed": "last step with t <= 0 (before the balloon pressure rises)",
-            "peak": peak_source,
-            "after": "last step",
-        },
-        "phases": {},
-    }
-    phase_out = section["phases"]
+
+def _balloon_pressures(ph):
+    """(balloon pressure at the peak, at the last step), None where not known."""
+    return num(get(ph["peak"], "balloon_pressure")), num(get(ph["after"], "balloon_pressure"))
+
+
+def _phase_entries(ph, times, beam_steps, layers, innermost, pstress):
+    """(the results.json "phases" map with per-layer stresses, the notes on them)."""
+    phase_out = {}
     for k in PHASES:
         s = ph[k]
         e = {"step": get(s, "step"), "time": times[k]}
@@ -337,23 +330,31 @@ def artery_report(run, scene, solid, beam, with_paper):
         e["lumen_diameter_min_all_stations"] = num(get(s, "lumen_diameter_min"))
         e["lumen_diameter_max_all_stations"] = num(get(s, "lumen_diameter_max"))
         phase_out[k] = e
-    pk_bp = num(get(ph["peak"], "balloon_pressure"))
-    after_bp = num(get(ph["after"], "balloon_pressure"))
+    pk_bp, after_bp = _balloon_pressures(ph)
     deflated = None if pk_bp is None or after_bp is None else after_bp <= 0.01 * pk_bp
     phase_out["after"]["deflated"] = deflated
-    section["notes"] = []
+    notes = []
     if deflated is False:
-        section["notes"].append(
+        notes.append(
             f"the run ended at t = {times['after']:g} s with the balloon at {after_bp / ATM:.3g} "
             "atm: the 'after' values are not after deflation"
         )
+    return phase_out, notes
 
-    f3 = lambda v: "-" if v is None else f"{v:g}"  # noqa: E731
+
+def _phase_rows(ph, times):
+    """Table rows of the phase times and the balloon pressure at the peak."""
+    rows = []
+    pk_bp = _balloon_pressures(ph)[0]
     if any(t is not None for t in times.values()):
-        rows.append(("artery phases t: prestressed / peak / after (s)", " / ".join(f3(times[k]) for k in PHASES), None))
+        rows.append(("artery phases t: prestressed / peak / after (s)", " / ".join(_g(times[k]) for k in PHASES), None))
     if pk_bp is not None:
         rows.append(("  balloon pressure at peak (atm)", pk_bp / ATM, None))
+    return rows
 
+
+def _stent_summary(beam, beam_steps, phase_out, times, P):
+    """(the results.json "stent" map: diameter at peak and final, recoil; its table rows)."""
     # stent diameter at the peak-pressure step and after deflation; recoil between the two
     d = get(beam, "diameter") if isinstance(get(beam, "diameter"), dict) else {}
     D_peak = phase_out["peak"]["stent_diameter"]
@@ -362,7 +363,7 @@ def artery_report(run, scene, solid, beam, with_paper):
         D_final = num(d.get("final"))
     recoil = D_peak - D_final if D_peak is not None and D_final is not None else None
     recoil_pct = 100 * recoil / D_peak if recoil is not None and D_peak else None
-    section["stent"] = {
+    stent = {
         "diameter_initial": num(d.get("initial")),
         "diameter_max": num(d.get("max")),
         "time_of_max": num(d.get("time_of_max")),
@@ -373,6 +374,7 @@ def artery_report(run, scene, solid, beam, with_paper):
         "recoil_percent": recoil_pct,
         "recoil_definition": "peak-pressure diameter minus final diameter (percent of the peak one)",
     }
+    stent_rows = []
     if beam:
         stent_rows += [
             ("stent diameter crimped (mm)", num(d.get("initial")), P.get("diameter_initial")),
@@ -382,7 +384,12 @@ def artery_report(run, scene, solid, beam, with_paper):
             ("elastic recoil, peak - final (mm)", recoil, P.get("recoil")),
             ("elastic recoil, peak - final (%)", recoil_pct, P.get("recoil_percent")),
         ]
+    return stent, stent_rows
 
+
+def _stress_rows(ph, phase_out, layers, P):
+    """Table rows of the prestressed artery displacement and the stresses per phase and layer (kPa)."""
+    rows = []
     # artery displacement and stresses per phase and layer (table in kPa)
     u_pre = num(get(phase_out, "prestressed", "max_displacement", "artery"))
     if u_pre is not None:
@@ -423,7 +430,11 @@ def artery_report(run, scene, solid, beam, with_paper):
                 rows.append(
                     (f"{k}: {L} p99 principal stress, nodal (kPa)", e["p99_principal_stress_nodal"] * KPA, None)
                 )
+    return rows
 
+
+def _lumen_summary(solid, ph):
+    """(the results.json "lumen" map, the stent's axial extent (min, max) or None, its table rows)."""
     # lumen
     stations = [num(v) for v in (get(solid, "lumen_stations") or [])]
     lumen = {"stations": stations, "profiles": {}, "min": {}, "stent_extent": None}
@@ -470,14 +481,18 @@ def artery_report(run, scene, solid, beam, with_paper):
         if lumen["min"].get("after") is not None and lumen["min"].get("prestressed") is not None
         else None
     )
-    section["lumen"] = lumen
+    rows = []
     where = "stented" if scope == "stented" else "all stations"
     for k in PHASES:
         if lumen["min"].get(k) is not None:
             rows.append((f"min lumen diameter {k}, {where} (mm)", lumen["min"][k], None))
     if lumen["gain_mean"] is not None:
         rows.append((f"lumen gain after - prestressed, mean {where} (mm)", lumen["gain_mean"], None))
+    return lumen, ext, rows
 
+
+def _apposition_summary(run, solid, phase_out, times):
+    """(the results.json "apposition" map of the stent after deflation, its table rows)."""
     # apposition after deflation
     thr = num(get(solid, "apposition_threshold"))
     app = phase_out["after"]["apposition"]
@@ -491,20 +506,28 @@ def artery_report(run, scene, solid, beam, with_paper):
         ap[key] = num(get(app, key))
     ap["malapposed_percent"] = scaled(ap.get("malapposed_fraction"), 100.0)
     ap["csv"] = app_csv
-    section["apposition"] = ap
+    rows = []
     if ap["malapposed_percent"] is not None:
         gt = f"gap > {thr:g} mm" if thr is not None else "gap > threshold"
         rows.append((f"malapposed stent length after ({gt}) (%)", ap["malapposed_percent"], None))
     if ap.get("max_gap") is not None:
         rows.append(("max strut-wall gap after (mm)", ap["max_gap"], None))
+    return ap, rows
 
+
+def _contact_force_summary(phase_out):
+    """(the results.json "contact_force_at_peak" map or None, its table rows)."""
     # contact forces on the artery at the peak
     cf = phase_out["peak"]["artery_contact_force"]
-    section["contact_force_at_peak"] = cf or None
+    rows = []
     for name, f in cf.items():
         if f is not None:
             rows.append((f"contact force {name} -> artery at peak (N)", f, None))
+    return cf or None, rows
 
+
+def _artery_plots(steps, layers, lumen, ext, times):
+    """The plot data of an artery scene: stress, lumen and force series, the stent's span, the lumen x axis."""
     # plot data
     t = [s["time"] for s in steps]
     # stresses on a log axis: without the stress-free reference state (step 0, round-off only)
@@ -521,12 +544,14 @@ def artery_report(run, scene, solid, beam, with_paper):
         nodal = [scaled(get(s, "max_principal_stress_nodal", L), KPA) for s in loaded]
         if any(v is not None for v in nodal):
             stress_series.append((f"{L} max nodal", t_loaded, nodal, ":", f"C{i}"))
+    stations = lumen["stations"]
+    n_st = len(stations)
     lumen_series = []
     for i, k in enumerate(PHASES):
         prof = lumen["profiles"][k]
         if prof and (len(prof) == n_st or not n_st):
             x = stations if n_st and all(v is not None for v in stations) else list(range(len(prof)))
-            lumen_series.append((f"{k} (t = {f3(times[k])} s)", x, prof, "o-", f"C{i}"))
+            lumen_series.append((f"{k} (t = {_g(times[k])} s)", x, prof, "o-", f"C{i}"))
     names = []
     for s in steps:
         for n in get(s, "artery_contact_force") or {}:
@@ -537,29 +562,70 @@ def artery_report(run, scene, solid, beam, with_paper):
         for i, n in enumerate(names)
     ]
     x_is_station = n_st > 0 and all(v is not None for v in stations)
-    plots = {
+    return {
         "stress": stress_series,
         "lumen": lumen_series,
         "force": force_series,
         "span": ext if (ext and x_is_station) else None,
         "lumen_x": "station" if x_is_station else "index",
     }
+
+
+def _straightening_rows(straight):
+    """Table rows of the artery axis sagitta and radius per phase (straightening of a patient artery)."""
+    labels = ["reference"] + [k for k in PHASES if k in straight]
+    return [
+        (
+            f"artery axis sagitta {' / '.join(labels)} (mm)",
+            " / ".join(f"{straight[k]['sagitta']:.3f}" for k in labels),
+            None,
+        ),
+        (
+            f"artery axis radius {' / '.join(labels)} (mm)",
+            " / ".join(f"{straight[k]['radius']:.1f}" for k in labels),
+            None,
+        ),
+    ]
+
+
+def artery_report(run, scene, solid, beam, with_paper):
+    """Table rows (stent rows, artery rows), the results.json "artery" section and the plot data of an
+    artery scene."""
+    P = (PAPER_PATIENT if (run / "geometry" / "placement.json").is_file() else PAPER_ARTERY) if with_paper else {}
+    steps = [s for s in (get(solid, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
+    beam_steps = [s for s in (get(beam, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
+    layers = artery_layers(solid, scene)
+    innermost = layers[0] if layers else None
+
+    ph, times, peak_source = _artery_phases(steps, beam, beam_steps)
+    phase_out, notes = _phase_entries(ph, times, beam_steps, layers, innermost, P.get("stress", {}))
+    section = {
+        "units": {"length": "mm", "stress": "MPa", "force": "N", "pressure": "MPa", "time": "s"},
+        "layers": layers,
+        "innermost_layer": innermost,
+        "paper": P or None,
+        "phase_definitions": {
+            "prestressed": "last step with t <= 0 (before the balloon pressure rises)",
+            "peak": peak_source,
+            "after": "last step",
+        },
+        "phases": phase_out,
+        "notes": notes,
+    }
+    rows = _phase_rows(ph, times)
+    section["stent"], stent_rows = _stent_summary(beam, beam_steps, phase_out, times, P)
+    rows += _stress_rows(ph, phase_out, layers, P)
+    section["lumen"], ext, lumen_rows = _lumen_summary(solid, ph)
+    rows += lumen_rows
+    section["apposition"], apposition_rows = _apposition_summary(run, solid, phase_out, times)
+    rows += apposition_rows
+    section["contact_force_at_peak"], force_rows = _contact_force_summary(phase_out)
+    rows += force_rows
+    plots = _artery_plots(steps, layers, section["lumen"], ext, times)
     straight = artery_straightening(run, times)
     if straight:
         section["straightening"] = straight
-        labels = ["reference"] + [k for k in PHASES if k in straight]
-        rows += [
-            (
-                f"artery axis sagitta {' / '.join(labels)} (mm)",
-                " / ".join(f"{straight[k]['sagitta']:.3f}" for k in labels),
-                None,
-            ),
-            (
-                f"artery axis radius {' / '.join(labels)} (mm)",
-                " / ".join(f"{straight[k]['radius']:.1f}" for k in labels),
-                None,
-            ),
-        ]
+        rows += _straightening_rows(straight)
     return (stent_rows, rows), section, plots
 
 
