@@ -151,14 +151,16 @@ def complete(scene, path, out_dir, log=print):
     into out_dir (the artery meshed from the lumen centerline, the stent and the scene's balloon placed
     at the stenosis, the virtual insertion where the lesion is narrower than the devices), and each
     phase's own balloon placed on the same device centerline, centred where the scene's balloon is.
-    Other scenes are returned unchanged. Raises ProcedureError naming the key."""
+    Returns (scene, placement): for a patient procedure what later phases are placed with on the
+    deformed lumen ({s_site, stent_length, stent_radius, zeta, margin}), else None with the scene
+    unchanged. Raises ProcedureError naming the key."""
     if insertion_tool.CURVE in (scene.get("load_curves") or {}):
         raise ProcedureError(
             f"{path}: load_curves.{insertion_tool.CURVE}: expected no curve of this name (the procedure "
             "writes the virtual insertion tool's radius under it)"
         )
     if "patient" not in scene:
-        return scene
+        return scene, None
     sys.path.insert(0, str(ROOT / "scripts"))
     import numpy as np
     from patient.centerline_csv import arc_length
@@ -166,7 +168,7 @@ def complete(scene, path, out_dir, log=print):
     from patient.prepare import prepare_scene
 
     try:
-        done, _ = prepare_scene(
+        done, report = prepare_scene(
             {k: v for k, v in scene.items() if k != "procedure"}, path, out_dir, log=lambda m: log(f"procedure: {m}")
         )
     except PatientInputError as e:
@@ -197,7 +199,15 @@ def complete(scene, path, out_dir, log=print):
             )
         m["centerline"] = copy.deepcopy(base["centerline"])
         m["start"] = round(max(start, 0.0), 9)
-    return done
+    spline = (scene["patient"].get("balloon_spline") or {}) if isinstance(scene["patient"], dict) else {}
+    placement = {
+        "s_site": report["placement"]["stenosis"]["arc_length"],
+        "stent_length": report["device"]["stent_length"],
+        "stent_radius": 0.5 * report["device"]["stent_crimped_outer_diameter"],
+        "zeta": spline.get("smoothing", scene_keys.default("patient.balloon_spline.smoothing")),
+        "margin": spline.get("clearance", scene_keys.default("patient.balloon_spline.clearance")),
+    }
+    return done, placement
 
 
 def _own_tool(scene):
@@ -210,11 +220,12 @@ def _own_tool(scene):
     return None if isinstance(r, dict) and r.get("curve") == insertion_tool.CURVE else ins
 
 
-def phase_scene(scene, phase, previous=None, tool=None):
+def phase_scene(scene, phase, previous=None, tool=None, placed=None):
     """The scene of one phase (a dict): the phase's time window, devices and contacts; `previous` =
     (run dir of the phase before, whether it had the stent): the states it continues from; `tool`:
-    the phase's virtual insertion (insertion_plan), if any. The patient pipeline's tool belongs to
-    the first phase."""
+    the phase's virtual insertion (insertion_plan), if any; `placed`: {balloon, stent: {file, start}}
+    device centerlines on the deformed lumen (deformed_placement), if any. The patient pipeline's
+    tool belongs to the first phase."""
     s = copy.deepcopy({k: v for k, v in scene.items() if k != "procedure"})
     if previous is not None and isinstance(s.get("contact"), dict) and not _own_tool(s):
         s["contact"].pop("insertion", None)
@@ -237,9 +248,52 @@ def phase_scene(scene, phase, previous=None, tool=None):
         }
         if prev_stent:
             s["stent"]["initial_state"] = {"file": str(Path(prev_dir) / "beam" / "state.h5")}
+    for part, key in (("balloon", "mesh"), ("stent", "generator")):
+        where = (placed or {}).get(part)
+        if where and part in s:
+            s[part][key]["centerline"] = {"file": str(where["file"])}
+            s[part][key]["start"] = round(float(where["start"]), 9)
     if tool is not None:
         insertion_tool.add_tool(s, tool["t0"], tool["t1"], tool["r0"], tool["r_open"], tool["penalty"])
     return s
+
+
+def deformed_placement(phase, k, summary, step, placement, stent_placed, geometry_dir, where):
+    """A patient procedure's phase after the first: its balloon (and the stent, in the phase that
+    deploys it) placed on the lumen the phase before left (patient/deformed_placement.py). Returns
+    {balloon, stent: {file, start}} (the stent's as deployed once it is), or None where the summary
+    has no deformed lumen or the phase no balloon."""
+    from patient.deformed_placement import place_on_deformed_lumen
+    from patient.errors import PatientInputError
+    from patient.placement import Device
+
+    if phase["balloon"] is None:
+        return {"stent": stent_placed} if stent_placed else None
+    L = float(phase["balloon"]["mesh"]["length"])
+    R = 0.5 * float(phase["balloon"]["mesh"]["outer_diameter"])
+    # the stent in place from an earlier phase is not placed again: only the balloon's clearance counts
+    new = phase["new_stent"]
+    dev = Device(
+        balloon_length=L,
+        balloon_radius=R,
+        stent_length=placement["stent_length"] if new else min(placement["stent_length"], L),
+        stent_radius=placement["stent_radius"] if new else R,
+    )
+    f = Path(geometry_dir) / f"device_centerline_{k + 1}-{phase['name']}.txt"
+    try:
+        placed = place_on_deformed_lumen(
+            summary, step, placement["s_site"], dev, placement["zeta"], placement["margin"], f, where
+        )
+    except PatientInputError as e:
+        raise ProcedureError(f"procedure[{k}]: the devices cannot be placed on the deformed lumen: {e}")
+    if placed is None:
+        return {"stent": stent_placed} if stent_placed else None
+    plc, stations = placed
+    out = {"balloon": {"file": f, "start": plc.balloon_start, "stations": stations}}
+    stent = {"file": f, "start": plc.stent_start} if new else stent_placed
+    if stent:
+        out["stent"] = stent
+    return out
 
 
 # --- the virtual insertion of a phase whose devices are wider than the lumen --------------------
@@ -307,12 +361,13 @@ def insertion_plan(scene, phase, k, lumen, path):
     }
 
 
-def lumen_under(summary, step, scene, phase):
+def lumen_under(summary, step, scene, phase, extent=None):
     """The minimal lumen diameter (mm) under the phase's balloon at one step of a solid summary
-    (all stations where the balloon's extent along them is not known); None without a lumen."""
+    (extent: the balloon's in the stations, else from the scene; all stations where it is not
+    known); None without a lumen."""
     stations = summary.get("lumen_stations") or []
     d = step.get("lumen_diameter") or []
-    ext = balloon_extent(phase["balloon"], scene["artery"]) if phase["balloon"] is not None else None
+    ext = extent or (balloon_extent(phase["balloon"], scene["artery"]) if phase["balloon"] is not None else None)
     mask = [ext[0] <= z <= ext[1] for z in stations] if ext and len(stations) == len(d) else None
     if mask is not None and not any(mask):
         mask = None
@@ -360,7 +415,7 @@ def check(scene, path, launch_args):
     """Every phase's scene through `launch.py --check` (without the states, which do not exist yet);
     a patient procedure is completed (meshed and placed) into a scratch directory first."""
     with tempfile.TemporaryDirectory(prefix="angio-procedure-") as tmp:
-        scene = complete(scene, path, Path(tmp) / "geometry")
+        scene, _ = complete(scene, path, Path(tmp) / "geometry")
         for k, ph in enumerate(phases(scene, path)):
             p = Path(tmp) / f"{k + 1}-{ph['name']}.yaml"
             _write(p, phase_scene(scene, ph), f"phase {k + 1} of {path}, as checked")
@@ -559,33 +614,41 @@ def run(scene, path, run_dir, launch_args):
     """Runs the phases one after the other (launch.py per phase); returns the exit code of the first
     failing phase, else 0."""
     run_dir = Path(run_dir)
-    scene = complete(scene, path, run_dir / "geometry")  # a patient procedure: meshed and placed again here
+    scene, placement = complete(scene, path, run_dir / "geometry")  # a patient procedure: meshed and placed here
     ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
-    ran, previous, code, tools = [], None, 0, {}
+    ran, previous, code, tools, placed = [], None, 0, {}, None
     for k, phase in enumerate(ph):
         pdir = phase_dir(run_dir, k, phase)
         scene_file = run_dir / f"{k + 1}-{phase['name']}.yaml"
         t0 = clock.time()
         try:
-            tool = None
+            tool, summary, step = None, None, None
+            if previous is not None:
+                summary = _load(previous[0] / "solid" / "summary.json") or {}
+                step = (summary.get("steps") or [{}])[-1]
+                if placement:
+                    where = str(previous[0] / "solid" / "summary.json")
+                    placed = deformed_placement(
+                        phase, k, summary, step, placement, (placed or {}).get("stent"), run_dir / "geometry", where
+                    )
             needs_lumen = phase["balloon"] is not None and not _own_tool(scene) and phase["stent"] <= phase["new_stent"]
             if needs_lumen and (previous is not None or "insertion" not in (scene.get("contact") or {})):
                 if previous is None:
                     summary, step = reference_lumen(scene, phase, run_dir, launch_args)
-                else:
-                    summary = _load(previous[0] / "solid" / "summary.json") or {}
-                    step = (summary.get("steps") or [{}])[-1]
-                tool = insertion_plan(scene, phase, k, lumen_under(summary, step, scene, phase), path)
+                ext = ((placed or {}).get("balloon") or {}).get("stations")
+                tool = insertion_plan(scene, phase, k, lumen_under(summary, step, scene, phase, ext), path)
         except ProcedureError as e:
             print(f"procedure: phase {k + 1} ({phase['name']}) not started: {e}", file=sys.stderr)
             ran.append((k, phase, "not started (exit 2)", clock.time() - t0))
             code = 2
             break
-        _write(scene_file, phase_scene(scene, phase, previous, tool), f"phase {k + 1} ({phase['name']}) of {path}")
-        note = ""
+        _write(
+            scene_file, phase_scene(scene, phase, previous, tool, placed), f"phase {k + 1} ({phase['name']}) of {path}"
+        )
+        note = ", devices on the deformed lumen" if placed and placed.get("balloon") else ""
         if tool is not None:
             tools[phase["name"]] = tool
-            note = (
+            note += (
                 f", virtual insertion (lumen {tool['lumen_diameter']:.3f} mm, devices {2 * tool['device_radius']:.3f}"
                 f" mm: the tool opens to {2 * tool['r_open']:.3f} mm until t = {tool['t1']:g} s)"
             )

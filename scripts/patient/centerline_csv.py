@@ -142,3 +142,13 @@ def write_centerline_csv(path, points, radius, wall=None, comment=""):
             if wall is not None:
                 row.append(f"{wall[i]:.6f}")
             w.writerow(row)
+
+
+def write_points(path, pts, comment):
+    """A polyline as text, one `x y z` (mm) per line after '#' comment lines (the centerline files
+    the solvers read)."""
+    with open(path, "w") as f:
+        for ln in comment.splitlines():
+            f.write(f"# {ln}\n")
+        for p in pts:
+            f.write(f"{p[0]:.9f} {p[1]:.9f} {p[2]:.9f}\n")

@@ -22,7 +22,7 @@ import insertion_tool
 import scene_keys
 
 from .artery_mesh import WallSpec, build_artery, layer_radii
-from .centerline_csv import read_centerline_csv, write_centerline_csv
+from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
 from .lumen_surface import read_lumen_surface
@@ -138,14 +138,6 @@ def add_insertion(done, plc, dev, ins, scene_path):
     return insertion_tool.add_tool(done, float(start), 0.0, r0, r_open, ins["penalty"], t_end=t_end)
 
 
-def _write_points(path, pts, comment):
-    with open(path, "w") as f:
-        for ln in comment.splitlines():
-            f.write(f"# {ln}\n")
-        for p in pts:
-            f.write(f"{p[0]:.9f} {p[1]:.9f} {p[2]:.9f}\n")
-
-
 def lumen_csv(pat, scene_path, out_dir, log):
     """The lumen centerline CSV of the scene: patient.centerline as given, or the one computed from
     patient.lumen_surface into out_dir/lumen_from_surface.csv."""
@@ -243,8 +235,8 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
                 f"lumen; a size below {ti[k]:.2f} mm is safer"
             )
     out.mkdir(parents=True, exist_ok=True)
-    _write_points(dev_file, plc.points, f"Balloon and stent centerline fitted to {csv_path} (paper §2.4), x y z mm")
-    _write_points(lumen_file, cl.points, f"Lumen centerline of {csv_path}, x y z mm (fiber frames)")
+    write_points(dev_file, plc.points, f"Balloon and stent centerline fitted to {csv_path} (paper §2.4), x y z mm")
+    write_points(lumen_file, cl.points, f"Lumen centerline of {csv_path}, x y z mm (fiber frames)")
     shutil.copyfile(csv_path, out / "lumen.csv")  # the input as it was (radii for the report)
     fit = (
         "the crimped devices overlap the wall by up to "

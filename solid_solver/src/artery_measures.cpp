@@ -56,7 +56,7 @@ LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<doub
                 groups_.end());
 }
 
-std::vector<double> LumenProfile::diameters(const std::vector<Vec3d>& x) const {
+std::vector<double> LumenProfile::diameters(const std::vector<Vec3d>& x, std::vector<Vec3d>* centroids) const {
   const size_t m = groups_.size();
   std::vector<Vec3d> c(m, Vec3d::Zero());
   for (size_t k = 0; k < m; ++k) {
@@ -78,6 +78,7 @@ std::vector<double> LumenProfile::diameters(const std::vector<Vec3d>& x) const {
     }
     d[k] = 2.0 * r / double(groups_[k].size());
   }
+  if (centroids) *centroids = std::move(c);
   return d;
 }
 

@@ -337,7 +337,7 @@ void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_
   }
   for (const auto& [part, u] : umax) s.max_displacement.emplace_back(part, u);
   if (lumen_.empty()) return;
-  s.lumen_diameter = lumen_.diameters(x);
+  s.lumen_diameter = lumen_.diameters(x, &s.lumen_centroid);
   if (!stent_x_.empty()) {  // where the stent sits, in the station coordinate of the lumen profile
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto& p : stent_x_) {
@@ -472,7 +472,7 @@ void SolidRunner::write_summary_json_() const {
     j["lumen_stations"] = lumen_.stations();
     j["lumen_measure"] =
         "lumen diameter per station along the reference vessel axis: 2 x mean distance of the endothelium nodes of the "
-        "station from their centroid";
+        "station from their centroid; lumen_centroid: that centroid (x, y, z), the deformed lumen centerline";
     j["artery_contact_force_measure"] = "sum over the endothelium nodes of |nodal contact force| (N), per contact";
     j["apposition_threshold"] = scene_.apposition_threshold;
   }
@@ -535,6 +535,8 @@ void SolidRunner::write_summary_json_() const {
       const auto [lo, hi] = std::minmax_element(s.lumen_diameter.begin(), s.lumen_diameter.end());
       e["lumen_diameter_min"] = *lo;
       e["lumen_diameter_max"] = *hi;
+      auto& c = e["lumen_centroid"] = ordered_json::array();
+      for (const auto& v : s.lumen_centroid) c.push_back({v.x(), v.y(), v.z()});
     }
     if (s.stent_stations) e["stent_stations"] = {s.stent_stations->first, s.stent_stations->second};
     for (const auto& [name, f] : s.artery_contact_force) e["artery_contact_force"][name] = f;

@@ -25,6 +25,7 @@ from patient.placement import (  # noqa: E402
     place_device,  # noqa: E402
     stenosis_site,
 )
+from patient.deformed_placement import place_on_deformed_lumen  # noqa: E402
 from patient.prepare import add_insertion  # noqa: E402
 
 
@@ -220,6 +221,54 @@ class Insertion(unittest.TestCase):
         done["load_curves"]["balloon"] = [[-0.2, 0.0], [1.0, 1.317]]
         with self.assertRaisesRegex(PatientInputError, "no balloon pressure before"):
             add_insertion(done, plc, self.DEV, {"clearance": 0.065, "penalty": 300.0}, "s.yaml")
+
+
+class DeformedPlacement(unittest.TestCase):
+    """A later phase's devices on the lumen the phase before left (patient/deformed_placement.py),
+    from the solid summary's station centroids and diameters. Consistency: a "deformed" lumen that
+    is the reference one gives the reference placement; a rigid translation of it translates the
+    device centerline and keeps its starts."""
+
+    DEV = Placement.DEV
+
+    def summary(self, cl, shift=(0.0, 0.0, 0.0)):
+        stations = [float(v) for v in cl.arc_length]
+        step = {
+            "lumen_centroid": (cl.points + np.asarray(shift)).tolist(),
+            "lumen_diameter": (2 * cl.radius).tolist(),
+        }
+        return {"lumen_stations": stations}, step
+
+    def test_reference_lumen_gives_the_reference_placement(self):
+        cl = Placement.centerline(self, noise=0.01, seed=3)
+        s_site = stenosis_site(cl)
+        ref = place_device(cl, self.DEV, s_site, insertion=True)
+        with tempfile.TemporaryDirectory() as d:
+            summary, step = self.summary(cl)
+            plc, ext = place_on_deformed_lumen(summary, step, s_site, self.DEV, 4.0, 0.0, Path(d) / "c.txt", "s")
+            np.testing.assert_allclose(plc.points, ref.points, atol=1e-9)
+            self.assertAlmostEqual(plc.balloon_start, ref.balloon_start, places=9)
+            self.assertAlmostEqual(plc.stent_start, ref.stent_start, places=9)
+            # the balloon's extent in the reference stations: centred on the site, its length long
+            self.assertAlmostEqual(0.5 * (ext[0] + ext[1]), s_site, places=9)
+            self.assertAlmostEqual(ext[1] - ext[0], self.DEV.balloon_length, places=9)
+            np.testing.assert_allclose(np.loadtxt(Path(d) / "c.txt"), ref.points, atol=1e-8)  # the file written
+
+    def test_translated_lumen_translates_the_devices(self):
+        cl = Placement.centerline(self, noise=0.01, seed=3)
+        s_site = stenosis_site(cl)
+        ref = place_device(cl, self.DEV, s_site, insertion=True)
+        with tempfile.TemporaryDirectory() as d:
+            summary, step = self.summary(cl, shift=(0.2, -0.1, 0.05))
+            plc, _ = place_on_deformed_lumen(summary, step, s_site, self.DEV, 4.0, 0.0, Path(d) / "c.txt", "s")
+        np.testing.assert_allclose(plc.points, ref.points + [0.2, -0.1, 0.05], atol=1e-9)
+        self.assertAlmostEqual(plc.balloon_start, ref.balloon_start, places=9)
+
+    def test_no_centroids_no_placement(self):
+        cl = Placement.centerline(self)
+        summary, step = self.summary(cl)
+        del step["lumen_centroid"]  # a summary of a solver before the centroids
+        self.assertIsNone(place_on_deformed_lumen(summary, step, 6.0, self.DEV, 4.0, 0.0, "/nonexistent", "s"))
 
 
 class ArteryMesh(unittest.TestCase):

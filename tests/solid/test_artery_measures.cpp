@@ -43,7 +43,8 @@ TEST(ArteryMeasures, WeightedQuantile) {
 }
 
 // Exact: the endothelium nodes of a generated tube lie on circles, so every station measures 2 r_i;
-// a rigid translation changes nothing, and a radial scaling of one ring changes only its station.
+// a rigid translation moves the centroids with it and changes no diameter, and a radial scaling of
+// one ring changes only its station.
 TEST(ArteryMeasures, LumenProfileOfATube) {
   const Mesh m = artery_tube(4.0, 1, 16, 8);
   const SurfaceSet* endo = m.surface("artery_inner");
@@ -59,8 +60,14 @@ TEST(ArteryMeasures, LumenProfileOfATube) {
   ASSERT_EQ(lp.stations().size(), 9u);  // the rings of the structured tube
   std::vector<Vec3d> x = m.X;
   for (double d : lp.diameters(x)) EXPECT_NEAR(d, 1.6, 1e-12);
+  // the centroids are the tube's axis points at the stations, and move with a rigid translation
+  std::vector<Vec3d> c;
+  lp.diameters(x, &c);
+  ASSERT_EQ(c.size(), lp.stations().size());
+  for (size_t k = 0; k < c.size(); ++k) EXPECT_LT((c[k] - Vec3d(0, 0, lp.stations()[k])).norm(), 1e-12);
   for (auto& p : x) p += Vec3d(0.3, -0.2, 1.0);
-  for (double d : lp.diameters(x)) EXPECT_NEAR(d, 1.6, 1e-12);
+  for (double d : lp.diameters(x, &c)) EXPECT_NEAR(d, 1.6, 1e-12);
+  for (size_t k = 0; k < c.size(); ++k) EXPECT_LT((c[k] - Vec3d(0.3, -0.2, 1.0 + lp.stations()[k])).norm(), 1e-12);
   x = m.X;
   for (int n : nodes)
     if (std::abs(m.X[n](2)) < 1e-9) x[n].head<2>() *= 1.25;  // the middle station (z = 0)

@@ -24,8 +24,9 @@ class LumenProfile {
   // nodes: endothelium nodes; station: their reference axial coordinate (arc length).
   LumenProfile(const std::vector<int>& nodes, const std::vector<double>& station, int max_stations);
   const std::vector<double>& stations() const { return s_; }  // mean reference station of each group (mm)
-  // x: current positions of all mesh nodes (indexed by mesh node).
-  std::vector<double> diameters(const std::vector<Vec3d>& x) const;
+  // x: current positions of all mesh nodes (indexed by mesh node); centroids (optional): each
+  // station's centroid, the deformed lumen centerline a later device is placed on.
+  std::vector<double> diameters(const std::vector<Vec3d>& x, std::vector<Vec3d>* centroids = nullptr) const;
   bool empty() const { return groups_.empty(); }
 
  private:

@@ -66,6 +66,7 @@ struct StepSummary {
   std::vector<BlockStress> stress;                               // per block
   std::vector<std::pair<std::string, double>> max_displacement;  // per part (mm)
   std::vector<double> lumen_diameter;                            // per lumen station (mm)
+  std::vector<Vec3d> lumen_centroid;                             // per lumen station (mm)
   std::vector<std::pair<std::string, double>>
       artery_contact_force;                                 // per contact: Σ |nodal force| on the endothelium (N)
   std::optional<Apposition> apposition;                     // stent vs endothelium
