@@ -3,6 +3,7 @@
 #include "angio/beam/ring_axis.hpp"
 #include "angio/common/clock.hpp"
 #include "angio/common/log.hpp"
+#include "angio/geometry/polyline.hpp"
 #include "angio/participant/plane_penalty.hpp"
 #include "angio/participant/types.hpp"
 
@@ -40,32 +41,16 @@ void gauss_legendre_01(int n, std::vector<double>& xi, std::vector<double>& w) {
 }
 
 Axis::Projection Axis::project(const Vec3& x) const {
-  Projection best;
-  double bestd = std::numeric_limits<double>::infinity();
-  double s0 = 0;
-  const int ns = static_cast<int>(points.size()) - 1;
-  for (int i = 0; i < ns; ++i) {
-    const Vec3 d = points[i + 1] - points[i];
-    const double len = d.norm();
-    if (len <= 0) continue;  // repeated point
-    double t = (x - points[i]).dot(d) / (len * len);
-    if (i > 0) t = std::max(t, 0.0);
-    if (i < ns - 1) t = std::min(t, 1.0);
-    const Vec3 foot = points[i] + t * d;
-    const double dist = (x - foot).norm();
-    if (dist < bestd - 1e-14) {
-      bestd = dist;
-      best.foot = foot;
-      best.tangent = d / len;
-      best.s = s0 + t * len;
-    }
-    s0 += len;
-  }
-  Vec3 rv = x - best.foot;
-  rv -= rv.dot(best.tangent) * best.tangent;
-  best.r = rv.norm();
-  best.radial = best.r > 0 ? Vec3(rv / best.r) : Vec3::Zero();
-  return best;
+  const auto c = geometry::closest_on_polyline(points, x, geometry::PolylineEnds::kExtended);
+  Projection p;
+  p.foot = c.foot;
+  p.tangent = c.tangent;
+  p.s = c.s;
+  Vec3 rv = x - c.foot;
+  rv -= rv.dot(c.tangent) * c.tangent;
+  p.r = rv.norm();
+  p.radial = p.r > 0 ? Vec3(rv / p.r) : Vec3::Zero();
+  return p;
 }
 
 int BeamModel::add_node(const Vec3& X) {

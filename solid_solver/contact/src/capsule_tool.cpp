@@ -1,5 +1,7 @@
 #include "angio/contact/capsule_tool.hpp"
 
+#include "angio/geometry/polyline.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
@@ -7,29 +9,13 @@
 namespace angio::contact {
 
 AxisDistance polyline_distance(const std::vector<Vec3>& axis, const Vec3& x) {
-  if (axis.size() < 2) throw std::invalid_argument("polyline_distance: an axis needs at least 2 points");
+  const auto c = geometry::closest_on_polyline(axis, x, geometry::PolylineEnds::kClamped);
   AxisDistance best;
-  double best_d2 = std::numeric_limits<double>::infinity();
-  bool best_inside = false;
-  Vec3 best_t = Vec3::Zero();
-  for (std::size_t i = 0; i + 1 < axis.size(); ++i) {
-    const Vec3 a = axis[i], d = axis[i + 1] - a;
-    const double L2 = d.squaredNorm();
-    if (!(L2 > 0.0)) throw std::invalid_argument("polyline_distance: a segment of zero length");
-    const double s = (x - a).dot(d) / L2;
-    const bool inside = s > 0.0 && s < 1.0;
-    const Vec3 foot = a + std::clamp(s, 0.0, 1.0) * d;
-    const double d2 = (x - foot).squaredNorm();
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best.foot = foot;
-      best_inside = inside;
-      best_t = d / std::sqrt(L2);
-    }
-  }
-  best.r = std::sqrt(best_d2);
+  best.foot = c.foot;
+  best.r = c.distance;
   if (best.r > 0.0) best.e_r = (x - best.foot) / best.r;
-  best.P = best_inside ? Mat3(Mat3::Identity() - best_t * best_t.transpose()) : Mat3(Mat3::Identity());
+  // beside a segment the foot slides along it (a cylinder), at a vertex or an end it stays (a sphere)
+  best.P = c.inside ? Mat3(Mat3::Identity() - c.tangent * c.tangent.transpose()) : Mat3(Mat3::Identity());
   return best;
 }
 
