@@ -29,6 +29,12 @@ struct OptionsScope {
   ~OptionsScope() { PetscOptionsPop(); }
   PetscOptions o_;
 };
+
+double norm2(Vec v) {
+  PetscReal n;
+  ANGIO_PETSC(VecNorm(v, NORM_2, &n));
+  return double(n);
+}
 }  // namespace
 
 SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats, ModelOptions options)
@@ -455,69 +461,202 @@ std::string SolidModel::invalid_element() const {
   return m.str();
 }
 
+void SolidModel::lift_prescribed_increment_(SolveReport& rep) {
+  // Prescribed displacement increment: lifted through one linearised solve at the old state
+  // (du_D = increment, K_FD du_D moved to the right-hand side), so the first iterate is a
+  // consistent predictor instead of a boundary layer of distorted elements.
+  std::vector<double> u_target = u_;
+  std::swap(u_, u_target);
+  apply_dirichlet_values_();
+  std::swap(u_, u_target);  // u_target: Dirichlet values at the new time
+  int any = 0;
+  for (const auto& bc : dirichlet_)
+    for (int n : bc.nodes) {
+      const int d = dof(n, bc.component);
+      if (u_target[d] != u_[d]) any = 1;
+    }
+  int any_global = 0;
+  MPI_Allreduce(&any, &any_global, 1, MPI_INT, MPI_MAX, comm_);
+  if (!any_global) return;
+  apply_bc_ = false;
+  const double tl = MPI_Wtime();
+  const bool lok = assemble(r_, K_);
+  apply_bc_ = true;
+  rep.assembly_seconds += MPI_Wtime() - tl;
+  if (!lok) return;
+  std::vector<PetscScalar> inc(dirichlet_rows_.size());
+  for (size_t i = 0; i < dirichlet_rows_.size(); ++i) inc[i] = u_target[dirichlet_rows_[i]] - u_[dirichlet_rows_[i]];
+  ANGIO_PETSC(VecSet(du_, 0.0));
+  ANGIO_PETSC(VecSetValues(du_, PetscInt(inc.size()), dirichlet_rows_.data(), inc.data(), INSERT_VALUES));
+  ANGIO_PETSC(VecAssemblyBegin(du_));
+  ANGIO_PETSC(VecAssemblyEnd(du_));
+  ANGIO_PETSC(VecScale(r_, -1.0));
+  ANGIO_PETSC(MatZeroRowsColumns(K_, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, du_, r_));
+  KSPConvergedReason reason;
+  ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));  // the tangent of the lifting itself
+  {
+    OptionsScope scope(options_);
+    ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+  }
+  ++rep.factorizations;
+  pc_current_ = true;
+  ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
+  if (reason > 0 || reason == KSP_DIVERGED_ITS) {
+    std::vector<double> du_full;
+    gather_(du_, du_full);
+    bool finite = true;
+    for (double v : du_full) finite = finite && std::isfinite(v);
+    if (finite)
+      for (size_t i = 0; i < u_.size(); ++i) u_[i] += du_full[i];
+  }
+}
+
+bool SolidModel::assemble_iterate_(SolveReport& rep, bool tangent) {
+  const double ta = MPI_Wtime();
+  const bool aok = assemble(r_, tangent ? K_ : nullptr);
+  rep.assembly_seconds += MPI_Wtime() - ta;
+  if (tangent) ++rep.tangent_assemblies;
+  return aok;
+}
+
+SolidModel::NewtonLinearSolve SolidModel::newton_linear_solve_(SolveReport& rep, bool fresh, int it, double res,
+                                                               std::vector<double>& du_full) {
+  const auto& no = opt_.newton;
+  const bool modified = no.modified;
+  NewtonLinearSolve out;
+  // linear solve K du = -r
+  ANGIO_PETSC(VecScale(r_, -1.0));
+  double t0 = MPI_Wtime();
+  KSPConvergedReason reason;
+  PetscInt lits;
+  const int lag = no.reuse_preconditioner;
+  bool reuse = modified ? !fresh : lag > 0 && pc_current_;
+  auto linear_solve = [&] {
+    ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse ? PETSC_TRUE : PETSC_FALSE));
+    {
+      OptionsScope scope(options_);
+      ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+    }
+    ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
+    ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
+    rep.linear_iterations += int(lits);
+    if (!reuse) ++rep.factorizations;
+  };
+  linear_solve();
+  if (modified) {
+    pc_current_ = reason > 0 || reason == KSP_DIVERGED_ITS;
+    if (reuse && reason < 0) {  // the old factorization no longer serves: the current tangent instead
+      rep.linear_seconds += MPI_Wtime() - t0;
+      out.iterations = lits;
+      out.current_tangent = true;
+      return out;
+    }
+  } else {
+    if (reuse && reason < 0) {  // the old preconditioner no longer serves: factorize this tangent
+      reuse = false;
+      linear_solve();
+    }
+    pc_current_ = !(reuse && lits > lag);  // slow with the old one: the next solve refactorizes
+  }
+  out.iterations = lits;
+  rep.linear_seconds += MPI_Wtime() - t0;
+  if (reason < 0 && reason != KSP_DIVERGED_ITS) {
+    std::ostringstream m;
+    m << "linear solver failed at Newton iteration " << it << ": " << KSPConvergedReasons[reason] << " after " << lits
+      << " iterations (residual " << res << ")";
+    out.failure = m.str();
+    return out;
+  }
+  gather_(du_, du_full);
+  bool finite = true;
+  for (double v : du_full) finite = finite && std::isfinite(v);
+  if (!finite) out.failure = "linear solve produced NaN/Inf at Newton iteration " + std::to_string(it);
+  return out;
+}
+
+SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const std::vector<double>& du_full, double res,
+                                                      bool stale, int it) {
+  const auto& no = opt_.newton;
+  const bool modified = no.modified;
+  u_base_ = u_;  // the iterate the step starts from (a member: no allocation per Newton iteration)
+  const std::vector<double>& u_base = u_base_;
+  // line search (backtracking on ||r||); exact Newton assembles the tangent with the trial
+  // residual so that an accepted full step costs no extra assembly. alpha ends as the last
+  // trial's step. A step of an old factorization (modified Newton) gets no line search: if it
+  // does not reduce ||r||, it is undone and the current tangent factorized instead.
+  double alpha = 1.0, best_alpha = 1.0, best_res = std::numeric_limits<double>::infinity();
+  double new_res = 0.0;
+  bool accepted = false;
+  const int tries = no.line_search && !stale ? no.max_line_search + 1 : 1;
+  for (int ls = 0;; ++ls, alpha *= 0.5) {
+    for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
+    const bool aok = assemble_iterate_(rep, !modified);
+    new_res = aok ? norm2(r_) : std::numeric_limits<double>::infinity();
+    if (!std::isfinite(new_res)) new_res = std::numeric_limits<double>::infinity();
+    if (new_res < best_res) {
+      best_res = new_res;
+      best_alpha = alpha;
+    }
+    accepted = new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res));
+    if (accepted || ls + 1 >= tries) break;
+  }
+  NewtonLineSearch out;
+  if (stale && !(new_res < res)) {  // the old factorization diverges here: back, and the current tangent
+    u_ = u_base;
+    out.undone = true;
+    return out;
+  }
+  if (!accepted && !stale) {
+    if (!std::isfinite(best_res)) {
+      out.failure = "Newton iteration " + std::to_string(it) +
+                    ": every line-search trial gave an invalid configuration (inverted element or NaN; " +
+                    invalid_element() + ")";
+      return out;
+    }
+    if (best_alpha != alpha) {  // r_ (and K_) hold the last trial: back to the best one
+      alpha = best_alpha;
+      for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
+      assemble_iterate_(rep, !modified);
+      new_res = norm2(r_);
+    }
+  }
+  out.alpha = alpha;
+  out.residual = new_res;
+  return out;
+}
+
+void SolidModel::log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale) {
+  // where the residual is largest: which part of the model keeps Newton from converging
+  PetscInt at = -1;
+  PetscReal rmax = 0.0;
+  ANGIO_PETSC(VecNorm(r_, NORM_INFINITY, &rmax));
+  {
+    const PetscScalar* a;
+    PetscInt lo, hi;
+    ANGIO_PETSC(VecGetOwnershipRange(r_, &lo, &hi));
+    ANGIO_PETSC(VecGetArrayRead(r_, &a));
+    for (PetscInt i = lo; i < hi; ++i)
+      if (std::abs(a[i - lo]) == rmax) at = i;
+    ANGIO_PETSC(VecRestoreArrayRead(r_, &a));
+  }
+  PetscInt at_global = -1;
+  MPI_Allreduce(&at, &at_global, 1, MPIU_INT, MPI_MAX, comm_);
+  if (rank_ == 0) {
+    const int node = at_global >= 0 ? iperm_[at_global / 3] : -1;
+    const Vec3d x = node >= 0 ? position(node) : Vec3d::Zero();
+    std::printf(
+        "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)\n",
+        it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1), x(2));
+  }
+}
+
 SolveReport SolidModel::solve(double loose_atol) {
   SolveReport rep;
   const double t_start = MPI_Wtime();
   const double contact_start = contact_seconds_;
   const auto& no = opt_.newton;
-  // Prescribed displacement increment: lifted through one linearised solve at the old state
-  // (du_D = increment, K_FD du_D moved to the right-hand side), so the first iterate is a
-  // consistent predictor instead of a boundary layer of distorted elements.
-  {
-    std::vector<double> u_target = u_;
-    std::swap(u_, u_target);
-    apply_dirichlet_values_();
-    std::swap(u_, u_target);  // u_target: Dirichlet values at the new time
-    int any = 0;
-    for (const auto& bc : dirichlet_)
-      for (int n : bc.nodes) {
-        const int d = dof(n, bc.component);
-        if (u_target[d] != u_[d]) any = 1;
-      }
-    int any_global = 0;
-    MPI_Allreduce(&any, &any_global, 1, MPI_INT, MPI_MAX, comm_);
-    if (any_global) {
-      apply_bc_ = false;
-      const double tl = MPI_Wtime();
-      const bool lok = assemble(r_, K_);
-      apply_bc_ = true;
-      rep.assembly_seconds += MPI_Wtime() - tl;
-      if (lok) {
-        std::vector<PetscScalar> inc(dirichlet_rows_.size());
-        for (size_t i = 0; i < dirichlet_rows_.size(); ++i)
-          inc[i] = u_target[dirichlet_rows_[i]] - u_[dirichlet_rows_[i]];
-        ANGIO_PETSC(VecSet(du_, 0.0));
-        ANGIO_PETSC(VecSetValues(du_, PetscInt(inc.size()), dirichlet_rows_.data(), inc.data(), INSERT_VALUES));
-        ANGIO_PETSC(VecAssemblyBegin(du_));
-        ANGIO_PETSC(VecAssemblyEnd(du_));
-        ANGIO_PETSC(VecScale(r_, -1.0));
-        ANGIO_PETSC(MatZeroRowsColumns(K_, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, du_, r_));
-        KSPConvergedReason reason;
-        ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));  // the tangent of the lifting itself
-        {
-          OptionsScope scope(options_);
-          ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
-        }
-        ++rep.factorizations;
-        pc_current_ = true;
-        ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
-        if (reason > 0 || reason == KSP_DIVERGED_ITS) {
-          std::vector<double> du_full;
-          gather_(du_, du_full);
-          bool finite = true;
-          for (double v : du_full) finite = finite && std::isfinite(v);
-          if (finite)
-            for (size_t i = 0; i < u_.size(); ++i) u_[i] += du_full[i];
-        }
-      }
-    }
-  }
+  lift_prescribed_increment_(rep);
   apply_dirichlet_values_();
-  auto norm = [&](Vec v) {
-    PetscReal n;
-    ANGIO_PETSC(VecNorm(v, NORM_2, &n));
-    return double(n);
-  };
   auto fail = [&](const std::string& msg) {
     rep.converged = false;
     rep.message = msg;
@@ -525,33 +664,28 @@ SolveReport SolidModel::solve(double loose_atol) {
     rep.contact_seconds = contact_seconds_ - contact_start;
     return rep;
   };
-  // Residual (and, with `tangent`, the tangent) at the current u_; false for an invalid configuration.
-  auto assemble_here = [&](bool tangent) {
-    const double ta = MPI_Wtime();
-    const bool aok = assemble(r_, tangent ? K_ : nullptr);
-    rep.assembly_seconds += MPI_Wtime() - ta;
-    if (tangent) ++rep.tangent_assemblies;
-    return aok;
+  auto invalid_at = [&](int it) {
+    return "invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")";
   };
   const bool modified = no.modified;
   const double atol = std::max(no.atol, loose_atol);
   // fresh: K_ holds the tangent at the current iterate (to be factorized); otherwise the modified
   // Newton iterates with the factorization held by the KSP.
   bool fresh = !modified || !pc_current_;
-  if (!assemble_here(fresh))
+  if (!assemble_iterate_(rep, fresh))
     return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN; " + invalid_element() +
                 ")");
-  double res = norm(r_);
+  double res = norm2(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
   if (no.verbose && rank_ == 0) std::printf("    newton  0  |r| = %.3e\n", res0);
   auto converged = [&](double r, int it) { return r <= atol || (it > 0 && r <= no.rtol * res0); };
   rep.residual_history.push_back(res);
-  std::vector<double> du_full, u_base;
+  std::vector<double> du_full;
   // Modified Newton: the old factorization failed or diverged at this iterate; the next iteration
   // factorizes the tangent here (the residual is unchanged, recorded again for the iteration count).
   auto current_tangent = [&] {
-    if (!assemble_here(true)) return false;
+    if (!assemble_iterate_(rep, true)) return false;
     fresh = true;
     rep.residual_history.push_back(res);
     return true;
@@ -571,125 +705,28 @@ SolveReport SolidModel::solve(double loose_atol) {
         << ")";
       return fail(m.str());
     }
-    // linear solve K du = -r
-    ANGIO_PETSC(VecScale(r_, -1.0));
-    double t0 = MPI_Wtime();
-    KSPConvergedReason reason;
-    PetscInt lits;
-    const int lag = no.reuse_preconditioner;
-    bool reuse = modified ? !fresh : lag > 0 && pc_current_;
-    auto linear_solve = [&] {
-      ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse ? PETSC_TRUE : PETSC_FALSE));
-      {
-        OptionsScope scope(options_);
-        ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
-      }
-      ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
-      ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
-      rep.linear_iterations += int(lits);
-      if (!reuse) ++rep.factorizations;
-    };
-    linear_solve();
-    if (modified) {
-      pc_current_ = reason > 0 || reason == KSP_DIVERGED_ITS;
-      if (reuse && reason < 0) {  // the old factorization no longer serves: the current tangent instead
-        rep.linear_seconds += MPI_Wtime() - t0;
-        if (!current_tangent())
-          return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() +
-                      ")");
-        continue;
-      }
-    } else {
-      if (reuse && reason < 0) {  // the old preconditioner no longer serves: factorize this tangent
-        reuse = false;
-        linear_solve();
-      }
-      pc_current_ = !(reuse && lits > lag);  // slow with the old one: the next solve refactorizes
-    }
-    rep.linear_seconds += MPI_Wtime() - t0;
-    if (reason < 0 && reason != KSP_DIVERGED_ITS) {
-      std::ostringstream m;
-      m << "linear solver failed at Newton iteration " << it << ": " << KSPConvergedReasons[reason] << " after " << lits
-        << " iterations (residual " << res << ")";
-      return fail(m.str());
-    }
-    gather_(du_, du_full);
-    bool finite = true;
-    for (double v : du_full) finite = finite && std::isfinite(v);
-    if (!finite) return fail("linear solve produced NaN/Inf at Newton iteration " + std::to_string(it));
-    u_base = u_;
-    // line search (backtracking on ||r||); exact Newton assembles the tangent with the trial
-    // residual so that an accepted full step costs no extra assembly. alpha ends as the last
-    // trial's step. A step of an old factorization (modified Newton) gets no line search: if it
-    // does not reduce ||r||, it is undone and the current tangent factorized instead.
-    const bool stale = modified && !fresh;
-    double alpha = 1.0, best_alpha = 1.0, best_res = std::numeric_limits<double>::infinity();
-    double new_res = 0.0;
-    bool accepted = false;
-    const int tries = no.line_search && !stale ? no.max_line_search + 1 : 1;
-    for (int ls = 0;; ++ls, alpha *= 0.5) {
-      for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
-      const bool aok = assemble_here(!modified);
-      new_res = aok ? norm(r_) : std::numeric_limits<double>::infinity();
-      if (!std::isfinite(new_res)) new_res = std::numeric_limits<double>::infinity();
-      if (new_res < best_res) {
-        best_res = new_res;
-        best_alpha = alpha;
-      }
-      accepted = new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res));
-      if (accepted || ls + 1 >= tries) break;
-    }
-    if (stale && !(new_res < res)) {  // the old factorization diverges here: back, and the current tangent
-      u_ = u_base;
-      if (!current_tangent())
-        return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
+    const NewtonLinearSolve linear = newton_linear_solve_(rep, fresh, it, res, du_full);
+    if (linear.current_tangent) {
+      if (!current_tangent()) return fail(invalid_at(it));
       continue;
     }
-    if (!accepted && !stale) {
-      if (!std::isfinite(best_res))
-        return fail("Newton iteration " + std::to_string(it) +
-                    ": every line-search trial gave an invalid configuration (inverted element or NaN; " +
-                    invalid_element() + ")");
-      if (best_alpha != alpha) {  // r_ (and K_) hold the last trial: back to the best one
-        alpha = best_alpha;
-        for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
-        assemble_here(!modified);
-        new_res = norm(r_);
-      }
+    if (!linear.failure.empty()) return fail(linear.failure);
+    const bool stale = modified && !fresh;  // a step of the old factorization (modified Newton)
+    const NewtonLineSearch step = line_search_(rep, du_full, res, stale, it);
+    if (step.undone) {  // the current tangent instead
+      if (!current_tangent()) return fail(invalid_at(it));
+      continue;
     }
+    if (!step.failure.empty()) return fail(step.failure);
     if (modified) {
       // keep the factorization while it contracts fast enough; otherwise the tangent here, for the
       // next iteration (the residual is assembled again with it)
-      fresh = !(new_res <= no.max_contraction * res) && !converged(new_res, it + 1);
-      if (fresh && !assemble_here(true))
-        return fail("invalid configuration at Newton iteration " + std::to_string(it) + " (" + invalid_element() + ")");
+      fresh = !(step.residual <= no.max_contraction * res) && !converged(step.residual, it + 1);
+      if (fresh && !assemble_iterate_(rep, true)) return fail(invalid_at(it));
     }
-    res = new_res;
+    res = step.residual;
     rep.residual_history.push_back(res);
-    if (no.verbose) {
-      // where the residual is largest: which part of the model keeps Newton from converging
-      PetscInt at = -1;
-      PetscReal rmax = 0.0;
-      ANGIO_PETSC(VecNorm(r_, NORM_INFINITY, &rmax));
-      {
-        const PetscScalar* a;
-        PetscInt lo, hi;
-        ANGIO_PETSC(VecGetOwnershipRange(r_, &lo, &hi));
-        ANGIO_PETSC(VecGetArrayRead(r_, &a));
-        for (PetscInt i = lo; i < hi; ++i)
-          if (std::abs(a[i - lo]) == rmax) at = i;
-        ANGIO_PETSC(VecRestoreArrayRead(r_, &a));
-      }
-      PetscInt at_global = -1;
-      MPI_Allreduce(&at, &at_global, 1, MPIU_INT, MPI_MAX, comm_);
-      if (rank_ == 0) {
-        const int node = at_global >= 0 ? iperm_[at_global / 3] : -1;
-        const Vec3d x = node >= 0 ? position(node) : Vec3d::Zero();
-        std::printf(
-            "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)\n",
-            it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1), x(2));
-      }
-    }
+    if (no.verbose) log_newton_iteration_(it, res, step.alpha, linear.iterations, stale);
   }
   rep.total_seconds = MPI_Wtime() - t_start;
   rep.contact_seconds = contact_seconds_ - contact_start;

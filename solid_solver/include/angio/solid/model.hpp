@@ -245,6 +245,34 @@ class SolidModel {
   // Faces of surface set `name` assembled by this rank (those whose first node it owns); `what` names the load.
   std::vector<Face> owned_faces_(const std::string& name, const char* what) const;
 
+  // --- the steps of solve()'s Newton iteration (collective)
+  // What the linear solve leaves one Newton iteration (newton_linear_solve_).
+  struct NewtonLinearSolve {
+    PetscInt iterations = 0;       // Krylov iterations of the (last) KSPSolve
+    bool current_tangent = false;  // modified Newton: the old factorization failed; take the current tangent
+    std::string failure;           // non-empty: the solve fails with this message
+  };
+  // What the line search leaves one Newton iteration (line_search_).
+  struct NewtonLineSearch {
+    double alpha = 1.0;     // the step taken along du
+    double residual = 0.0;  // ||r|| there (r_, and K_ in exact Newton, assembled there)
+    bool undone = false;    // an old factorization's step that did not reduce ||r||: u_ back; take the current tangent
+    std::string failure;    // non-empty: the solve fails with this message
+  };
+  // Lifts a prescribed displacement increment by one linearised solve: Newton starts from a consistent predictor.
+  void lift_prescribed_increment_(SolveReport& rep);
+  // Residual (and, with `tangent`, the tangent) at the current u_, timed and counted in rep; false for an invalid
+  // configuration.
+  bool assemble_iterate_(SolveReport& rep, bool tangent);
+  // K du = -r with modified Newton's / the lagged preconditioner's factorization reuse; du gathered into du_full.
+  NewtonLinearSolve newton_linear_solve_(SolveReport& rep, bool fresh, int it, double res,
+                                         std::vector<double>& du_full);
+  // Backtracking on ||r|| along du_full (an old factorization's step: none, undone if it fails), to the best trial.
+  NewtonLineSearch line_search_(SolveReport& rep, const std::vector<double>& du_full, double res, bool stale, int it);
+  // The verbose log line of iteration it (rank 0): where the residual is largest, what keeps Newton from converging.
+  void log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale);
+
+  std::vector<double> u_base_;  // line_search_'s starting iterate
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   Mesh mesh_;
