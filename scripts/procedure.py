@@ -15,9 +15,10 @@ else the scene's), which starts crimped and is gone in the next phase.
 The first phase starts at time.start; each later one where the one before ended. Load curves are in
 that one time axis. `time:` keeps its other keys (min_step, max_cuts, adaptive); its `end` and
 `steps` are per phase. Devices are placed where the scene places them (on the vessel axis; in a
-patient scene the pipeline places the stent and the scene's balloon at the stenosis once and each
-phase's balloon on the same device centerline), not on the deformed lumen's centerline: right for
-straight and gently curved vessels, whose axis a dilatation hardly moves.
+patient scene the pipeline places the stent and the scene's balloon at the stenosis and each phase's
+balloon on the same device centerline); in a patient procedure each phase after the first places
+its devices on the lumen the phase before left (deformed_placement), the stent as deployed once it
+is; in a generated tube they stay on its axis (a concentric dilatation does not move it).
 
 A phase whose crimped devices (its balloon; the stent in the phase that deploys it) are wider than
 the lumen under them plus `procedure[k].insertion.clearance` opens the lumen first with the virtual
