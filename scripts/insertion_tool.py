@@ -12,11 +12,21 @@ configs/stability/severe_stenosis_insertion.yaml runs with. Units: mm, N, MPa, s
 """
 import math
 
+import scene_keys
+
 CURVE = "insertion_tool"  # the load curve the tool's radius follows (a scene may not use the name)
 # inside the narrowest lumen: the tool starts at this fraction of its radius (contact from the start
 # would push the wall in the first step at full penalty)
 START_FRACTION = 0.9
 OPEN, CONTACTS_ON, HOLD = 0.5, 0.55, 0.6  # fractions of the window
+
+
+def crimped_stent_radius(stent):
+    """The crimped stent's outer radius (mm) from a scene's `stent:` section: crimped diameter / 2 +
+    the strut's contact radius (the generator's declared default diameter where the scene has none)."""
+    g, sec = stent.get("generator") or {}, stent.get("section") or {}
+    crimped = g.get("crimped_diameter", scene_keys.default("stent.generator.crimped_diameter"))
+    return 0.5 * float(crimped) + float(sec.get("contact_radius", sec.get("radius", 0.0)))
 
 
 def curve_value(points, t):

@@ -304,11 +304,14 @@ def device_radius(scene, phase):
     """The outer radius of the phase's crimped devices (mm): its balloon, and the stent where the
     phase deploys it (crimped diameter / 2 + the strut's contact radius)."""
     r = 0.5 * float(phase["balloon"]["mesh"]["outer_diameter"])
-    if phase["new_stent"]:
-        g, sec = scene["stent"].get("generator") or {}, scene["stent"].get("section") or {}
-        crimped = g.get("crimped_diameter", scene_keys.default("stent.generator.crimped_diameter"))
-        r = max(r, 0.5 * float(crimped) + float(sec.get("contact_radius", sec.get("radius", 0.0))))
-    return r
+    return max(r, insertion_tool.crimped_stent_radius(scene["stent"])) if phase["new_stent"] else r
+
+
+def _tool_may_serve(scene, phase):
+    """Whether a virtual insertion can serve the phase at all: it has a balloon, the scene brings no
+    tool of its own, and no stent is in place from an earlier phase (the balloon goes inside it,
+    which the tool, pushing the artery only, cannot open)."""
+    return phase["balloon"] is not None and not _own_tool(scene) and not (phase["stent"] and not phase["new_stent"])
 
 
 def pressure_free_until(scene, phase):
@@ -327,9 +330,7 @@ def insertion_plan(scene, phase, k, lumen, path):
     minimal lumen diameter (mm) under the phase's balloon at the phase's start. Raises ProcedureError
     when the devices do not fit and the tool cannot work (insertion off, or no pressure-free time)."""
     ins = phase["insertion"]
-    # with the stent in place from an earlier phase the balloon goes inside it, where the tool
-    # (which pushes the artery only) has nothing to open
-    if phase["balloon"] is None or lumen is None or _own_tool(scene) or (phase["stent"] and not phase["new_stent"]):
+    if lumen is None or not _tool_may_serve(scene, phase):
         return None
     R = device_radius(scene, phase)
     if 0.5 * lumen >= R + ins["clearance"]:
@@ -632,8 +633,9 @@ def run(scene, path, run_dir, launch_args):
                     placed = deformed_placement(
                         phase, k, summary, step, placement, (placed or {}).get("stent"), run_dir / "geometry", where
                     )
-            needs_lumen = phase["balloon"] is not None and not _own_tool(scene) and phase["stent"] <= phase["new_stent"]
-            if needs_lumen and (previous is not None or "insertion" not in (scene.get("contact") or {})):
+            # the pipeline's tool (in the scene's contact) already serves a patient's first phase
+            first_has_tool = previous is None and "insertion" in (scene.get("contact") or {})
+            if _tool_may_serve(scene, phase) and not first_has_tool:
                 if previous is None:
                     summary, step = reference_lumen(scene, phase, run_dir, launch_args)
                 ext = ((placed or {}).get("balloon") or {}).get("stations")

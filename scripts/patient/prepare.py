@@ -98,7 +98,7 @@ def device_of(scene, scene_path):
         balloon_length=float(bm["length"]),
         balloon_radius=0.5 * float(bm["outer_diameter"]),
         stent_length=float(stent_length),
-        stent_radius=0.5 * float(crimped) + float(sec),
+        stent_radius=insertion_tool.crimped_stent_radius(scene["stent"]),
     )
 
 
