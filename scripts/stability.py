@@ -3,6 +3,7 @@
 
   scripts/stability.py                          # every case in configs/stability/
   scripts/stability.py configs/stability/penalty_x100.yaml --keep runs/stability
+  scripts/stability.py --processors CASE        # the cores a case's run occupies (for ctest)
 
 A case file names a shipped scene (`base`, relative to the case file), the keys it changes (`set`:
 dotted key paths, each value replaces the base's) and what must happen (`expect`):
@@ -28,6 +29,7 @@ import time
 
 import yaml
 
+from launch import solid_ranks
 from scene_variant import SetError, apply_set, launch_command, variant_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -194,12 +196,22 @@ def main():
     ap.add_argument("cases", nargs="*", help="case files (default: configs/stability/*.yaml)")
     ap.add_argument("--keep", help="keep the run directories here (default: a temporary directory)")
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
+    ap.add_argument(
+        "--processors",
+        action="store_true",
+        help="print the cores each case's run occupies (its solid ranks: the staggered participants "
+        "take turns) and exit, without running",
+    )
     a = ap.parse_args()
     cases = a.cases or sorted(
         os.path.join(ROOT, "configs", "stability", f)
         for f in os.listdir(os.path.join(ROOT, "configs", "stability"))
         if f.endswith(".yaml")
     )
+    if a.processors:
+        for c in cases:
+            print(solid_ranks(compose(load_case(c), c)[1], c))
+        return 0
     with tempfile.TemporaryDirectory() as tmp:
         out = a.keep or tmp
         os.makedirs(out, exist_ok=True)
