@@ -76,10 +76,78 @@ def layer_radii(r, wall, spec, where):
     return np.column_stack([r, r + ti, r + ti + tm, r + wall]), ti, tm, ta
 
 
+def _sector_solids(occ, regions, s, P, t, n1, radii):
+    """One OCC solid per plaque region: a loft through pie-slice sections in the normal planes at
+    from_s, the loft stations between and to_s, from the centerline out to the lumen radius plus
+    offset + thickness (or into the media: to the intima's outer surface), less the pie slice out to
+    the lumen radius plus offset when the region starts below the lumen. The slice's part in the
+    lumen core is removed with the core; only its part in the intima becomes plaque."""
+    out = []
+    for reg in regions:
+        outer = _pie_loft(
+            occ,
+            reg,
+            s,
+            P,
+            t,
+            n1,
+            radii,
+            lambda lumen, i_out, m_out: (
+                lumen + reg.offset + reg.thickness if reg.thickness is not None else 0.5 * (i_out + m_out)
+            ),
+        )
+        if reg.offset > 0.0:
+            inner = _pie_loft(occ, reg, s, P, t, n1, radii, lambda lumen, i_out, m_out: lumen + reg.offset)
+            outer, _ = occ.cut(outer, inner)
+        out.append([dt for dt in outer if dt[0] == 3])
+    return out
+
+
+def _pie_loft(occ, reg, s, P, t, n1, radii, radius_of):
+    """The loft through the region's pie-slice sections of radius radius_of(lumen, intima's outer,
+    media's outer radius) per section."""
+    ss = np.concatenate([[reg.from_s], s[(s > reg.from_s + 1e-6) & (s < reg.to_s - 1e-6)], [reg.to_s]])
+    Pk = np.column_stack([np.interp(ss, s, P[:, c]) for c in range(3)])
+    tk = np.column_stack([np.interp(ss, s, t[:, c]) for c in range(3)])
+    tk /= np.linalg.norm(tk, axis=1)[:, None]
+    nk = np.column_stack([np.interp(ss, s, n1[:, c]) for c in range(3)])
+    nk -= np.einsum("ij,ij->i", nk, tk)[:, None] * tk
+    nk /= np.linalg.norm(nk, axis=1)[:, None]
+    bk = np.cross(tk, nk)
+    R = radius_of(*(np.interp(ss, s, radii[:, j]) for j in range(3)))
+    a0, a1 = (math.radians(a) for a in reg.angle)
+    if reg.full_circle:
+        angles = a0 + 0.5 * math.pi * np.arange(4)
+    else:  # arcs of at most 90 degrees (OCC's circle arcs must stay below 180)
+        angles = np.linspace(a0, a1, max(1, math.ceil((a1 - a0) / (0.5 * math.pi) - 1e-9)) + 1)
+    wires = []
+    for i in range(len(ss)):
+        c = occ.addPoint(*Pk[i])
+        q = [occ.addPoint(*(Pk[i] + R[i] * (math.cos(a) * nk[i] + math.sin(a) * bk[i]))) for a in angles]
+        if reg.full_circle:
+            edges = [occ.addCircleArc(q[k], c, q[(k + 1) % 4]) for k in range(4)]
+        else:
+            arcs = [occ.addCircleArc(q[k], c, q[k + 1]) for k in range(len(q) - 1)]
+            edges = [occ.addLine(c, q[0])] + arcs + [occ.addLine(q[-1], c)]
+        wires.append(occ.addWire(edges))
+    return occ.addThruSections(wires, makeSolid=True, makeRuled=False)
+
+
 def build_artery(
-    points, radius, wall, spec, mesh_size, out_path, binary=False, loft_spacing=0.5, where="patient", log=print
+    points,
+    radius,
+    wall,
+    spec,
+    mesh_size,
+    out_path,
+    binary=False,
+    loft_spacing=0.5,
+    where="patient",
+    log=print,
+    plaque=(),
 ):
-    """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts."""
+    """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts. `plaque`: the
+    regions of the intima with their own volume group (plaque.PlaqueRegion, checked)."""
     import gmsh
 
     s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
@@ -106,22 +174,33 @@ def build_artery(
             vol = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
             solids.append([dt for dt in vol if dt[0] == 3])
         all_in = [dt for sl in solids for dt in sl]
-        _, pieces_of = occ.fragment(all_in, [])
+        sectors = _sector_solids(occ, plaque, s, P, t, n1, radii)
+        _, pieces_of = occ.fragment(all_in + [dt for sl in sectors for dt in sl], [])
         occ.synchronize()
-        # a piece inside k of the four nested solids: 4 = lumen core, 3 intima, 2 media, 1 adventitia
-        count = {}
-        for inp in pieces_of:
+        # a piece inside k of the four nested solids: 4 = lumen core, 3 intima, 2 media, 1 adventitia;
+        # an intima piece inside a plaque region's solid is that region's plaque
+        count, region_of = {}, {}
+        for i, inp in enumerate(pieces_of):
             for dt in inp:
-                count[dt] = count.get(dt, 0) + 1
-        by_layer = {name: [] for name in LAYERS}
+                if i < len(all_in):
+                    count[dt] = count.get(dt, 0) + 1
+                else:
+                    region_of[dt] = plaque[i - len(all_in)].layer
+        groups = list(LAYERS) + sorted({reg.layer for reg in plaque})
+        by_layer = {name: [] for name in groups}
         core = []
         for dt, k in count.items():
             if k == 4:
                 core.append(dt)
+            elif LAYERS[3 - k] == "intima" and dt in region_of:
+                by_layer[region_of[dt]].append(dt[1])
             else:
                 by_layer[LAYERS[3 - k]].append(dt[1])
+        if set(region_of) - set(count):
+            raise RuntimeError("a plaque region reaches outside the wall")
         if any(not v for v in by_layer.values()) or not core:
-            raise RuntimeError("gmsh fragment did not give three nested layers")
+            empty = [name for name, v in by_layer.items() if not v]
+            raise RuntimeError(f"gmsh fragment did not give three nested layers and the plaque (empty: {empty})")
 
         def faces(vols):
             out = set()
@@ -131,6 +210,7 @@ def build_artery(
 
         core_faces = faces([c[1] for c in core])
         f_int, f_med, f_adv = (faces(by_layer[n]) for n in LAYERS)
+        f_int |= faces([v for name in groups[len(LAYERS) :] for v in by_layer[name]])  # plaque: the intima's part
 
         def on_plane(tag, p, normal):
             c = np.array(occ.getCenterOfMass(2, tag))
@@ -143,7 +223,7 @@ def build_artery(
         outer = sorted(f_adv - f_med - set(end0) - set(end1))
         occ.remove(core, recursive=True)
         occ.synchronize()
-        for name in LAYERS:
+        for name in groups:
             gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, by_layer[name]), name)
         for name, tags in (("endothelium", endo), ("outer", outer), ("end0", end0), ("end1", end1)):
             if not tags:
@@ -181,7 +261,7 @@ def build_artery(
         n_tets = sum(len(tg) for tg in tags)
         node_tags, _, _ = gmsh.model.mesh.getNodes()
         per_layer = {
-            name: sum(len(tg) for v in by_layer[name] for tg in gmsh.model.mesh.getElements(3, v)[1]) for name in LAYERS
+            name: sum(len(tg) for v in by_layer[name] for tg in gmsh.model.mesh.getElements(3, v)[1]) for name in groups
         }
         return {
             "file": str(out_path),
@@ -191,6 +271,7 @@ def build_artery(
             "per_layer": per_layer,
             "mesh_size": mesh_size,
             "straightened_tet10": int(straightened),
+            "min_scaled_jacobian": _min_scaled_jacobian(),
             "stations": int(len(P)),
             "thickness_range": {
                 "intima": [float(ti.min()), float(ti.max())],
@@ -224,6 +305,30 @@ def _min_quadratic_jacobian():
         if len(dets):
             lo = min(lo, float(np.min(dets)))
     return lo
+
+
+def _min_scaled_jacobian():
+    """The smallest scaled Jacobian of the tet10: det J at the Gauss points and the ten nodes, over
+    det J of the element's straight-sided tet4 (1 for a straight-sided tet10, <= 0 inverted or
+    folded; the measure gmsh's high-order optimizer works on). gmsh 4.8's own quality API has no
+    scaled Jacobian, so it is computed from getJacobians."""
+    import gmsh
+
+    tags, nodes = gmsh.model.mesh.getElementsByType(11)
+    if not len(tags):
+        return math.nan
+    gauss, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
+    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    mids = np.array([0.5 * (corners[a] + corners[b]) for a, b in TET10_EDGES])
+    local = np.concatenate([gauss, corners.ravel(), mids.ravel()])
+    _, dets, coords = gmsh.model.mesh.getJacobians(11, local)
+    dets = dets.reshape(len(tags), -1)
+    # the straight-sided tet4's det J from its corners: the 4 corner sample points' coordinates
+    xyz = coords.reshape(len(tags), -1, 3)
+    ng = len(gauss) // 3
+    c = xyz[:, ng : ng + 4]
+    straight = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
+    return float(np.min(dets.min(axis=1) / straight))
 
 
 # gmsh tet10 mid-edge nodes 4..9 on the edges 01 12 20 30 32 31 (gmsh manual, "Node ordering")

@@ -27,6 +27,7 @@ from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
 from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
+from .plaque import check_within_intima, plaque_materials, read_plaque
 
 # The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
 # and checked by scene_keys.check_map.
@@ -206,8 +207,17 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     spec = WallSpec(
         media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"], min_intima=wall["min_intima"]
     )
+    plaque = read_plaque(pat["plaque"], float(cl.arc_length[-1]), scene_path)
+    if plaque:
+        check_within_intima(plaque, cl.arc_length, layer_radii(cl.radius, wall_t, spec, str(csv_path))[1], scene_path)
+    layers = artery.get("layers")
+    if not isinstance(layers, dict):
+        raise PatientInputError(
+            f"{scene_path}: artery.layers: expected a map layer name -> material, got {layers!r:.60}"
+        )
     msh = out / "artery.msh"
     done = copy.deepcopy(scene)
+    done["artery"]["layers"].update(plaque_materials(plaque, layers, scene_path))
     del done["patient"]
     _absolute_files(done, scene_path.parent)
     done["artery"]["mesh"] = {
@@ -260,8 +270,12 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         loft_spacing=mesh["loft_spacing"],
         where=str(csv_path),
         log=log,
+        plaque=plaque,
     )
-    log(f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs)")
+    log(
+        f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs), minimal scaled "
+        f"Jacobian {info['min_scaled_jacobian']:.3f}"
+    )
     report = {
         "centerline": str(csv_path),
         "points": int(len(cl.radius)),
@@ -270,6 +284,17 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         "placement": plc.report(),
         "insertion": ins_report,
         "artery_mesh": info,
+        "plaque": [
+            {
+                "layer": r.layer,
+                "from_s": r.from_s,
+                "to_s": r.to_s,
+                "angle": list(r.angle),
+                "thickness": r.thickness if r.thickness is not None else "intima",
+                "material": done["artery"]["layers"][r.layer],
+            }
+            for r in plaque
+        ],
         "device": {
             "balloon_length": dev.balloon_length,
             "balloon_outer_diameter": 2 * dev.balloon_radius,

@@ -52,7 +52,10 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
           resolve_fibers(mat, mesh_.frames.size() == mesh_.elements.size() ? mesh_.frames[e]
                                                                            : element_frame(mesh_, int(e), opt_.axis));
   }
-  // reference Jacobians must be positive (catches inverted elements of imported meshes early)
+  // reference Jacobians must be positive (the scene reader refuses inverted meshes; this guards
+  // meshes built in code)
+  if (const std::string bad = first_invalid_element(mesh_); !bad.empty())
+    throw std::runtime_error("solid mesh: " + bad);
   std::vector<double> volume(mesh_.elements.size(), 0.0);  // reference volume per element
   {
     Eigen::VectorXd N;
@@ -65,10 +68,6 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
         shape(el.type, qp.xi, N, dN);
         const double detJ = (X.transpose() * dN).determinant();
         volume[e] += qp.w * detJ;
-        if (!(detJ > 0.0))
-          throw std::runtime_error("solid mesh: element " + std::to_string(e) + " (" + name(el.type) + ", block '" +
-                                   mesh_.blocks[el.block].name +
-                                   "') has a non-positive reference Jacobian (inverted or degenerate)");
       }
     }
   }

@@ -107,6 +107,10 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     } catch (const std::exception& e) {
       mesh.child("file").fail(std::string("a readable gmsh 4.1 mesh, ASCII or binary (") + e.what() + ")");
     }
+    // an inverted element is refused before anything runs (it would stop the first Newton solve)
+    if (const std::string bad = first_invalid_element(m); !bad.empty())
+      mesh.child("file").fail("a mesh without inverted elements; in " + path + " " + bad);
+    const std::string surfaces = surface_names(m, prefix);
     axis = read_axis(mesh, Vec3d::Zero());
     if (auto cl = mesh.optional("centerline")) {
       // fiber frames from a lumen centerline (patient-specific arteries, paper §4.2.1): [[x, y, z], ...],
@@ -126,7 +130,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
           s.name = canonical;
           return;
         }
-      mesh.child(key).fail("the name of a surface physical group in " + path);
+      mesh.child(key).fail("the name of a surface physical group in " + path + " (it has: " + surfaces + ")");
     };
     rename("inner", prefix + "inner");
     if (mesh.has("outer")) {
@@ -147,7 +151,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
             s.name = prefix + "end" + std::to_string(i);
             found = true;
           }
-        if (!found) ends.at(i).fail("the name of a surface physical group in " + path);
+        if (!found) ends.at(i).fail("the name of a surface physical group in " + path + " (it has: " + surfaces + ")");
       }
     }
     return m;
@@ -223,11 +227,15 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
   }
   axis = Axis{t.center, Vec3d::UnitZ()};
   check_memory(mesh, double(t.n_circ) * (t.n_axial + 1.0) * (shells(t) + 1.0));
+  Mesh m;
   try {
-    return make_tube(t);
+    m = make_tube(t);
   } catch (const std::runtime_error& e) {
     mesh.fail(std::string("a valid tube (") + e.what() + ")");
   }
+  if (const std::string bad = first_invalid_element(m); !bad.empty())
+    mesh.fail("a tube without inverted elements; " + bad);
+  return m;
 }
 
 // The peak of value x load curve is checked against the key's declared plausible peak (keys.yaml).
@@ -377,12 +385,19 @@ void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc)
       read_part_mesh(a.child("mesh", "a mesh {generator: tube, ...} or {file: ...}"), "artery", true, axis, curved);
   const Node layers = a.child("layers", "a map layer name -> material {E, nu, fibers}");
   if (!layers.is_map()) layers.fail("a map layer name -> material {E, nu, fibers}");
+  const Node mesh_node = a.child("mesh");
+  const std::string source =
+      mesh_node.has("file") ? scene::resolve_path(mesh_node, mesh_node.get<std::string>("file")) : "the generated tube";
   for (const auto& blk : m.blocks) {
-    if (!layers.has(blk.name)) layers.fail("a material for layer '" + blk.name + "'");
+    if (!layers.has(blk.name))
+      layers.fail("a material for every layer of the artery mesh, missing '" + blk.name + "' (" + source +
+                  " has: " + block_names(m) + ")");
     sc.materials.push_back(read_material(layers.child(blk.name), blk.name));
   }
   for (const auto& k : layers.keys())
-    if (m.block_index(k) < 0) layers.child(k).fail("a layer of the artery mesh (no block named '" + k + "')");
+    if (m.block_index(k) < 0)
+      layers.child(k).fail("a layer of the artery mesh; " + source + " has no layer '" + k +
+                           "' (it has: " + block_names(m) + ")");
   if (a.has("blood_pressure"))
     sc.pressures.push_back(read_pressure(a, "blood_pressure", "artery_inner", curves, "blood_pressure",
                                          scene::keys::peaks::artery_blood_pressure,

@@ -155,6 +155,8 @@ class LumenSurface(unittest.TestCase):
         self.assertTrue(os.path.isfile(os.path.join(out, "lumen_from_surface.csv")))
         self.assertAlmostEqual(report["lumen_length"], LENGTH, delta=0.1)
         self.assertAlmostEqual(min(report["lumen_diameter_range"]), 1.8, delta=0.02)  # 40 % of 3 mm
+        # gmsh's minimal scaled Jacobian of the written mesh: positive (no inverted element), at most 1
+        self.assertTrue(0.0 < report["artery_mesh"]["min_scaled_jacobian"] <= 1.0, report["artery_mesh"])
         # both keys, or a thickness from a column the surface does not have: refused naming the key
         both = dict(scene, patient=dict(scene["patient"], centerline="x.csv"))
         with self.assertRaisesRegex(PatientInputError, "exactly one of centerline"):

@@ -290,3 +290,30 @@ TEST(GmshReader, UnknownSectionsSkippedPartitionedRefused) {
     EXPECT_NE(msg.find("partitioned"), std::string::npos) << msg;
   }
 }
+
+// Reference validity (exact geometry): the tube is valid; one element turned inside out by swapping
+// two corner nodes (a mirror image: det J changes sign everywhere) is found at a Gauss point; a tet10
+// whose mid-edge node is pulled past the corner at the end of its edge folds there and is found.
+TEST(MeshValidity, InvertedAndFoldedElementsFound) {
+  Mesh m = read_tube(kBinary);
+  EXPECT_EQ(first_invalid_element(m), "");
+  Mesh swapped = m;
+  std::swap(swapped.elements[7].n[0], swapped.elements[7].n[1]);
+  const std::string what = first_invalid_element(swapped);
+  EXPECT_NE(
+      what.find("element 7 (counted from 0 in file order; tet10, block '" + m.blocks[m.elements[7].block].name + "'"),
+      std::string::npos)
+      << what;
+  EXPECT_NE(what.find("at a Gauss point"), std::string::npos) << what;
+  Mesh folded = m;
+  Element& el = folded.elements[3];
+  // mid-edge node 4 of edge 0-1 moved beyond corner 1 (x4 = x1 + 0.75 (x1 - x0)): the map folds near node 1
+  const Vec3d x0 = m.X[el.n[0]], x1 = m.X[el.n[1]];
+  folded.X.push_back(x1 + 0.75 * (x1 - x0));
+  el.n[4] = int(folded.X.size()) - 1;
+  const std::string fold = first_invalid_element(folded);
+  EXPECT_NE(fold.find("element 3 "), std::string::npos) << fold;
+  EXPECT_NE(fold.find("inverted or degenerate"), std::string::npos) << fold;
+  EXPECT_EQ(block_names(m), "media, adventitia");
+  EXPECT_NE(surface_names(m, "artery_").find("inner"), std::string::npos);
+}

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <memory>
 #include <numbers>
+#include <iterator>
+#include <sstream>
 #include <type_traits>
 
 #include <unistd.h>
@@ -696,4 +698,67 @@ TEST(Model, InvalidConfigurationNamesTheElement) {
   EXPECT_FALSE(model.assemble(model.residual_vector(), nullptr));
   const std::string what = model.invalid_element();
   EXPECT_NE(what.find("of block 'cube' at ("), std::string::npos) << what;
+}
+
+// A mesh file with an inverted element, or a scene whose layers and mesh disagree, is refused when
+// the scene is read, naming the file, the element or the names the mesh does have.
+TEST(Scene, ArteryMeshFileCheckedAgainstTheScene) {
+  const std::string data = ANGIO_SOLID_TEST_DATA;
+  std::ifstream in(data + "/layered_tube_ascii.msh");
+  std::string msh((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string tag = std::to_string(getpid()) + "_" + std::to_string(world_rank());
+  const std::string dir = std::filesystem::temp_directory_path();
+  // the first tet10 (type 11) entity block: swap the first two nodes of its first element
+  size_t line = msh.find('\n', msh.find('\n', msh.find("$Elements")) + 1) + 1;  // the first block header
+  for (;;) {
+    std::istringstream header(msh.substr(line, msh.find('\n', line) - line));
+    long dim = 0, entity = 0, type = 0, count = 0;
+    ASSERT_TRUE(header >> dim >> entity >> type >> count);
+    line = msh.find('\n', line) + 1;
+    if (type == 11) break;
+    for (long k = 0; k < count; ++k) line = msh.find('\n', line) + 1;
+  }
+  std::istringstream first(msh.substr(line, msh.find('\n', line) - line));
+  std::vector<long> ids{std::istream_iterator<long>(first), std::istream_iterator<long>()};
+  ASSERT_EQ(ids.size(), 11u);
+  std::swap(ids[1], ids[2]);
+  std::string swapped;
+  for (long v : ids) swapped += std::to_string(v) + " ";
+  std::string bad = msh;
+  bad.replace(line, msh.find('\n', line) - line, swapped);
+  const std::string good_msh = dir + "/angio_good_" + tag + ".msh", bad_msh = dir + "/angio_inverted_" + tag + ".msh";
+  std::ofstream(good_msh) << msh;
+  std::ofstream(bad_msh) << bad;
+  auto scene = [&](const std::string& mesh, const std::string& layers) {
+    const std::string path = dir + "/angio_mesh_scene_" + tag + ".yaml";
+    std::ofstream(path) << "time: {end: 1.0, steps: 1}\n"
+                           "load_curves: {ramp: [[0, 0], [1, 1]]}\n"
+                           "artery:\n  mesh: {file: "
+                        << mesh
+                        << ", inner: inner, outer: outer, ends: [end0, end1]}\n"
+                           "  layers:\n"
+                        << layers << "  blood_pressure: {value: 0.01, curve: ramp}\n";
+    return path;
+  };
+  const std::string two = "    media: {E: 0.1, nu: 0.45}\n    adventitia: {E: 0.01, nu: 0.45}\n";
+  auto error = [&](const std::string& path) -> std::string {
+    try {
+      read_solid_scene(angio::scene::load_scene(path));
+    } catch (const angio::scene::SceneError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error(scene(good_msh, two)), "");
+  std::string w = error(scene(bad_msh, two));
+  EXPECT_NE(w.find("artery.mesh.file"), std::string::npos) << w;
+  EXPECT_NE(w.find(bad_msh), std::string::npos) << w;
+  EXPECT_NE(w.find("inverted"), std::string::npos) << w;
+  w = error(scene(good_msh, two + "    intima: {E: 0.1, nu: 0.45}\n"));
+  EXPECT_NE(w.find("has no layer 'intima' (it has: media, adventitia)"), std::string::npos) << w;
+  EXPECT_NE(w.find(good_msh), std::string::npos) << w;
+  w = error(scene(good_msh, "    media: {E: 0.1, nu: 0.45}\n"));
+  EXPECT_NE(w.find("missing 'adventitia'"), std::string::npos) << w;
+  std::filesystem::remove(good_msh);
+  std::filesystem::remove(bad_msh);
 }

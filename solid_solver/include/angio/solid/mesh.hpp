@@ -123,5 +123,13 @@ void set_frames_from_centerline(Mesh& m, const std::vector<Vec3d>& centerline);
 // foot (normal to the tangent), circumferential = axial x radial (right-handed, orthonormal).
 void set_frames_from_curved_axis(Mesh& m, const geometry::Centerline& centerline);
 Vec3d element_centroid(const Mesh& m, int e);
+// The first element whose reference Jacobian determinant is not positive at a Gauss point or at one
+// of its nodes (inverted, degenerate or folded), described with its index, type, block and
+// centroid; empty when every element is valid.
+std::string first_invalid_element(const Mesh& m);
+// "a, b, c": the names of the mesh's blocks or surface sets (the latter without `prefix`), for
+// messages that name what a mesh does have.
+std::string block_names(const Mesh& m);
+std::string surface_names(const Mesh& m, const std::string& prefix);
 
 }  // namespace angio::solid
