@@ -583,20 +583,26 @@ SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const st
   // residual so that an accepted full step costs no extra assembly. alpha ends as the last
   // trial's step. A step of an old factorization (modified Newton) gets no line search: if it
   // does not reduce ||r||, it is undone and the current tangent factorized instead.
-  double alpha = 1.0, best_alpha = 1.0, best_res = std::numeric_limits<double>::infinity();
+  double alpha = 1.0, best_alpha = 1.0, best_merit = std::numeric_limits<double>::infinity();
   double new_res = 0.0;
   bool accepted = false;
   const int tries = no.line_search && !stale ? no.max_line_search + 1 : 1;
+  // energy merit: the slope at the start (r_ holds -r(u_base) here, negated for the linear solve); a
+  // direction that is not a descent one (s0 >= 0) falls back to the residual merit
+  const double s0 = no.energy_line_search && tries > 1 ? -slope_along_(du_full) : 0.0;
+  const bool energy = s0 < 0.0;
   for (int ls = 0;; ++ls, alpha *= 0.5) {
     for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
     const bool aok = assemble_iterate_(rep, !modified);
     new_res = aok ? norm2(r_) : std::numeric_limits<double>::infinity();
     if (!std::isfinite(new_res)) new_res = std::numeric_limits<double>::infinity();
-    if (new_res < best_res) {
-      best_res = new_res;
+    const double merit = !std::isfinite(new_res) ? new_res : energy ? std::abs(slope_along_(du_full)) : new_res;
+    if (merit < best_merit) {
+      best_merit = merit;
       best_alpha = alpha;
     }
-    accepted = new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res));
+    accepted = energy ? merit <= 0.8 * std::abs(s0)
+                      : new_res <= (1.0 - 1e-4 * alpha) * res || (!no.line_search && std::isfinite(new_res));
     if (accepted || ls + 1 >= tries) break;
   }
   NewtonLineSearch out;
@@ -606,7 +612,7 @@ SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const st
     return out;
   }
   if (!accepted && !stale) {
-    if (!std::isfinite(best_res)) {
+    if (!std::isfinite(best_merit)) {
       out.failure = "Newton iteration " + std::to_string(it) +
                     ": every line-search trial gave an invalid configuration (inverted element or NaN; " +
                     invalid_element() + ")";
@@ -622,6 +628,17 @@ SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const st
   out.alpha = alpha;
   out.residual = new_res;
   return out;
+}
+
+double SolidModel::slope_along_(const std::vector<double>& du_full) {
+  const PetscScalar* r;
+  ANGIO_PETSC(VecGetArrayRead(r_, &r));
+  double local = 0.0;
+  for (int i = 3 * node_begin_; i < 3 * node_end_; ++i) local += du_full[i] * r[i - 3 * node_begin_];
+  ANGIO_PETSC(VecRestoreArrayRead(r_, &r));
+  double global = 0.0;
+  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  return global;
 }
 
 void SolidModel::log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale) {

@@ -433,6 +433,7 @@ void read_solver_options(const Node& s, SolidScene& sc) {
     no.atol = n->get<double>("atol");
     no.line_search = n->get<bool>("line_search");
     no.max_line_search = n->get<int>("max_line_search");
+    no.energy_line_search = n->get<std::string>("line_search_merit") == "energy";
     no.verbose = n->get<bool>("verbose");
     no.damping = n->get<double>("damping");
     if (auto dp = n->optional("damping_parts")) {
