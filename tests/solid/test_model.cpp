@@ -92,6 +92,32 @@ ModelOptions direct_options() {
   return o;
 }
 
+// A thick tube "cyl" (inner radius a, wall b - a in n_radial elements) along z, and the plane-strain
+// supports of the thick-cylinder problem: no axial motion, symmetry on the planes x = 0 and y = 0.
+Mesh thick_tube(double a, double b, int n_radial, int n_circ, int n_axial, double length) {
+  TubeSpec s;
+  s.part = "cyl";
+  s.surface_prefix = "cyl_";
+  s.length = length;
+  s.inner_radius = a;
+  s.layers = {{"wall", b - a, n_radial}};
+  s.n_circ = n_circ;
+  s.n_axial = n_axial;
+  return make_tube(s);
+}
+void plane_strain_supports(SolidModel& model, const Mesh& m) {
+  std::vector<int> all(m.X.size()), xzero, yzero;
+  for (size_t n = 0; n < m.X.size(); ++n) {
+    all[n] = int(n);
+    if (std::abs(m.X[n].x()) < 1e-9) xzero.push_back(int(n));
+    if (std::abs(m.X[n].y()) < 1e-9) yzero.push_back(int(n));
+  }
+  auto zero = [](const Vec3d&, double) { return 0.0; };
+  model.add_dirichlet({all, 2, zero});
+  model.add_dirichlet({xzero, 0, zero});
+  model.add_dirichlet({yzero, 1, zero});
+}
+
 // The distorted unit cube pressed by a follower pressure p on the face x = 1, rollers on the
 // planes x = 0, y = 0, z = 0, at t = 1.
 std::unique_ptr<SolidModel> pressed_cube(const Mesh& m, const LayerMaterial& mat, const ModelOptions& o, double p) {
@@ -380,26 +406,9 @@ TEST(Model, ViscousBranchCreepsToTheElasticEquilibrium) {
 // solution u_r(r) = (1+nu)/E [(1-2nu) A r + B/r], A = p a^2/(b^2-a^2), B = p a^2 b^2/(b^2-a^2).
 TEST(Model, ThickCylinderMatchesLame) {
   const double a = 1.0, b = 2.0, E = 1.0, nu = 0.3, p = 1e-4;
-  TubeSpec s;
-  s.part = "cyl";
-  s.surface_prefix = "cyl_";
-  s.length = 0.2;
-  s.inner_radius = a;
-  s.layers = {{"wall", b - a, 8}};
-  s.n_circ = 64;
-  s.n_axial = 1;
-  Mesh m = make_tube(s);
-  std::vector<int> all(m.X.size()), xzero, yzero;
-  for (size_t n = 0; n < m.X.size(); ++n) {
-    all[n] = int(n);
-    if (std::abs(m.X[n].x()) < 1e-9) xzero.push_back(int(n));
-    if (std::abs(m.X[n].y()) < 1e-9) yzero.push_back(int(n));
-  }
+  const Mesh m = thick_tube(a, b, 8, 64, 1, 0.2);
   SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"wall", {E, nu}, {}}}, direct_options());
-  auto zero = [](const Vec3d&, double) { return 0.0; };
-  model.add_dirichlet({all, 2, zero});
-  model.add_dirichlet({xzero, 0, zero});
-  model.add_dirichlet({yzero, 1, zero});
+  plane_strain_supports(model, m);
   model.add_pressure({"cyl_inner", [p](double t) { return p * t; }});
   model.set_time(1.0);
   const SolveReport rep = model.solve();
@@ -422,31 +431,14 @@ TEST(Model, ThickCylinderMatchesLame) {
 // same equilibrium as the residual merit (consistency) in fewer Newton iterations (measured 6 against
 // 17; at 5 x the pressure the residual merit did not converge in 60).
 TEST(Model, EnergyLineSearchMeritNearIncompressibility) {
-  TubeSpec s;
-  s.part = "cyl";
-  s.surface_prefix = "cyl_";
-  s.length = 0.5;
-  s.inner_radius = 1.0;
-  s.layers = {{"wall", 0.5, 3}};
-  s.n_circ = 32;
-  s.n_axial = 3;
-  const Mesh m = make_tube(s);
+  const Mesh m = thick_tube(1.0, 1.5, 3, 32, 3, 0.5);
   auto run = [&](bool energy, SolveReport& rep) {
     ModelOptions o = direct_options();
     o.petsc_options = "-ksp_type preonly -pc_type lu";
     o.newton.max_iterations = 60;
     o.newton.energy_line_search = energy;
     SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cyl", {1.0, 0.499}, {}}}, o);
-    std::vector<int> all(m.X.size()), xzero, yzero;
-    for (size_t n = 0; n < m.X.size(); ++n) {
-      all[n] = int(n);
-      if (std::abs(m.X[n].x()) < 1e-9) xzero.push_back(int(n));
-      if (std::abs(m.X[n].y()) < 1e-9) yzero.push_back(int(n));
-    }
-    auto zero = [](const Vec3d&, double) { return 0.0; };
-    model.add_dirichlet({all, 2, zero});
-    model.add_dirichlet({xzero, 0, zero});
-    model.add_dirichlet({yzero, 1, zero});
+    plane_strain_supports(model, m);
     model.add_pressure({"cyl_inner", [](double t) { return 0.02 * t; }});
     model.set_time(1.0);
     rep = model.solve();
