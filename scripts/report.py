@@ -19,7 +19,8 @@ where the element value sits half an element inside), with the nodal maximum on 
 that of the innermost layer), the artery displacement, the lumen
 profile (and lumen gain over the stented stations), the apposition of the stent after deflation
 and the contact forces on the artery. Plots: diameter_vs_time.png, diameter_vs_pressure.png and,
-with an artery, stress_vs_time.png, lumen_profile.png, contact_force_vs_time.png.
+with an artery, stress_vs_time.png, lumen_profile.png, contact_force_vs_time.png and
+artery_stress_peak.png / artery_stress_after.png (the wall cut open, coloured by stress; artery_views.py).
 """
 import csv
 import json
@@ -642,6 +643,25 @@ def artery_straightening(run, times):
         return None
 
 
+def _artery_views(run, solid, phases):
+    """artery_stress_peak.png and artery_stress_after.png (artery_views.py): the wall cut open, coloured
+    by the first principal stress, with the stent; none without h5py/matplotlib."""
+    blocks = {
+        b["id"]: b["name"] for b in get(solid, "blocks") or [] if isinstance(b, dict) and b.get("part") == "artery"
+    }
+    views = [(k, num(get(phases, k, "time"))) for k in ("peak", "after")]
+    views = [(k, t) for k, t in views if t is not None]
+    if not blocks or not views:
+        return []
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    try:
+        from artery_views import render
+
+        return render(run, views, blocks, [f"artery_stress_{k}.png" for k, _ in views])
+    except ImportError:  # h5py or matplotlib missing: the report goes without the pictures
+        return []
+
+
 # ------------------------------------------------------------------------------------------------
 def main(run_dir):
     run = Path(run_dir)
@@ -852,6 +872,8 @@ def main(run_dir):
                 run / "contact_force_vs_time.png", pl["force"], "pseudo-time t (s)", "contact force on the artery (N)"
             )
             written.append("contact_force_vs_time.png")
+    if artery and (run / "solid" / "solid.h5").is_file():
+        written += _artery_views(run, solid, artery[1]["phases"])
     written = [n for n in written if (run / n).is_file()]
     print(f"report: {run / 'results.json'}" + (f" and {', '.join(written)}" if written else ""))
 
