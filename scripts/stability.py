@@ -158,7 +158,9 @@ def run_case(case_path, out_dir, build_dir):
     with variant_scene(base_path, scene, f"stability_{name}", header) as scene_path:
         try:
             r = subprocess.run(
-                launch_command(scene_path, run_dir, build_dir, "--timeout", "60"),
+                # a peer silent for a tenth of the case's wall budget (at least 60 s) is a hang; a
+                # fixed 60 s stopped a patient procedure whose solid solves took longer on a busy machine
+                launch_command(scene_path, run_dir, build_dir, "--timeout", f"{max(60.0, 0.1 * max_wall):g}"),
                 capture_output=True,
                 text=True,
                 errors="replace",
