@@ -484,7 +484,7 @@ SolidScene read_solid_scene(const Node& root) {
   if (auto s = root.optional("solid"))
     if (auto is = s->optional("initial_state")) read_initial_state(*is, root, sc);
   // The Newton stops at ||r|| <= atol whatever the load; an atol of the order of the loads' own norm
-  // accepts a loaded step before anything moves (found by the Newton-tolerance ladder of scripts/work_precision.py:
+  // accepts a loaded step before anything moves (found by the Newton-tolerance ladder of bench/work_precision.py:
   // atol 1 N on the straight scene, the balloon never inflated and the run ended "ok").
   std::vector<std::pair<std::string, double>> peaks;
   for (const auto& p : sc.pressures) {

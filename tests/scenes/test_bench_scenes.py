@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""scripts/bench_scenes.py end to end on a 3-step variant of the straight free expansion.
+"""bench/bench_scenes.py end to end on a 3-step variant of the straight free expansion.
 
   test_bench_scenes.py BIN_DIR
 
@@ -35,7 +35,7 @@ def main():
         out = tmp / "runs"
         cmd = [
             "/usr/bin/python3",
-            str(ROOT / "scripts" / "bench_scenes.py"),
+            str(ROOT / "bench" / "bench_scenes.py"),
             str(path),
             "--out-dir",
             str(out),

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""scripts/sensitivity.py in CI on a 3-step variant of the straight free expansion (t = 0 .. 0.09 s,
+"""bench/sensitivity.py in CI on a 3-step variant of the straight free expansion (t = 0 .. 0.09 s,
 the stent just in contact, D = 1.156 mm): a study with two changes (balloon end springs 100 -> 1000
 N/mm^3, stent-balloon penalty 10 -> 20 N/mm^2) gives three finished runs, JSON/CSV and a Markdown
 table; the baseline's differences are zero; both changes move D_peak. The stiffer penalty must give
@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from checklist import check, finish  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = str(ROOT / "scripts" / "sensitivity.py")
+SCRIPT = str(ROOT / "bench" / "sensitivity.py")
 CHANGES = [
     {"name": "balloon end springs 1000", "set": {"balloon.end_springs": 1000.0}},
     {"name": "stent-balloon penalty 20", "set": {"contact.stent_balloon.penalty": 20.0}},

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""scripts/work_precision.py --quick in CI on a 4-step variant of the straight free
+"""bench/work_precision.py --quick in CI on a 4-step variant of the straight free
 expansion: every run of the quick ladders (load steps x 1/2, 1, 2; coupling rel_tol 1e-2, 1e-3,
 1e-4; beam elements per strut 2, 3) finishes, the JSON/CSV/PNG are written, the finest run of a
 ladder without a Richardson reference has zero error, and tightening the coupling tolerance brings
@@ -33,7 +33,7 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
     r = subprocess.run(
         [
             "/usr/bin/python3",
-            str(ROOT / "scripts" / "work_precision.py"),
+            str(ROOT / "bench" / "work_precision.py"),
             str(scene),
             "--quick",
             "--out-dir",
@@ -70,7 +70,7 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
     r2 = subprocess.run(
         [
             "/usr/bin/python3",
-            str(ROOT / "scripts" / "work_precision.py"),
+            str(ROOT / "bench" / "work_precision.py"),
             str(scene),
             "--quick",
             "--out-dir",
@@ -99,7 +99,7 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
     r3 = subprocess.run(
         [
             "/usr/bin/python3",
-            str(ROOT / "scripts" / "work_precision.py"),
+            str(ROOT / "bench" / "work_precision.py"),
             str(scene),
             "--knobs",
             "coupling_tol",

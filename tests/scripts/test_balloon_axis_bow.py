@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""scripts/balloon_axis_bow.py on a synthetic run directory (no solver; stdlib unittest + h5py).
+"""bench/balloon_axis_bow.py on a synthetic run directory (no solver; stdlib unittest + h5py).
 
 A curved balloon is written as rings of nodes around a circular-arc centerline of radius 15 mm
 (solid.h5 layout of the solid solver: /mesh/coordinates, /mesh/hex8/{connectivity, block_id},
@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scripts"))
+sys.path.insert(0, str(ROOT / "bench"))
 from balloon_axis_bow import arc_length_of, circle_radius  # noqa: E402
 
 R, LENGTH, N_RING, N_AXIAL, r_tube = 15.0, 18.0, 12, 73, 0.49
@@ -93,7 +93,7 @@ class Script(unittest.TestCase):
                     g.attrs["time"] = t
                     g["displacement"] = u
             r = subprocess.run(
-                [sys.executable, str(ROOT / "scripts" / "balloon_axis_bow.py"), str(run)],
+                [sys.executable, str(ROOT / "bench" / "balloon_axis_bow.py"), str(run)],
                 capture_output=True,
                 text=True,
             )

@@ -691,7 +691,7 @@ TEST(Scene, AbsurdBalloonPressureIsRefusedNamingTheValue) {
 
 // solid.newton.atol is judged against the norm of the peak pressure load (load_scale.hpp): at
 // kMaxAtolOfLoad of it the scene is refused naming the key, just below it is accepted. Consistency
-// with the scene's own load norm (the straight scene's Newton ladder of scripts/work_precision.py: atol ~ the load norm
+// with the scene's own load norm (the straight scene's Newton ladder of bench/work_precision.py: atol ~ the load norm
 // accepted every step at iteration 0 and the balloon never inflated).
 TEST(Scene, AbsoluteToleranceOfTheOrderOfTheLoadIsRefused) {
   const std::string shipped = std::string(ANGIO_CONFIGS_DIR) + "/solid_free_balloon.yaml";

@@ -1,5 +1,5 @@
 // Round-trip latency of request/reply between two processes, for payloads shaped like the
-// coupling data (n 3-vectors of doubles). Driven by scripts/bench_transport_latency.py.
+// coupling data (n 3-vectors of doubles). Driven by bench/bench_transport_latency.py.
 //
 //   transport_latency_bench server --listen EP --key K
 //       echoes every request; an empty request is the shutdown signal.

@@ -6,7 +6,7 @@ radial line load of configs/beam_stent_radial_expansion.yaml up to t = 0.5 (plas
 runs beam_solver once per linear solver and prints the Newton time per iteration from
 summary.json (assembly with exact tangent + sparse factorization + solve).
 
-Usage: scripts/bench_beam.py [--exe build-beam/bin/beam_solver] [--rings 11] [--steps 20]
+Usage: bench/bench_beam.py [--exe build-beam/bin/beam_solver] [--rings 11] [--steps 20]
 """
 import argparse
 import json

@@ -3,14 +3,14 @@
 stresses move when one modelling choice changes (end springs, peak pressure, wall split, a contact
 penalty, ...), each change run on its own against the same baseline.
 
-  scripts/sensitivity.py STUDY.yaml [--out-dir DIR] [--build-dir DIR] [--reuse JSON|RUN_DIR ...] [--only NAME ...]
+  bench/sensitivity.py STUDY.yaml [--out-dir DIR] [--build-dir DIR] [--reuse JSON|RUN_DIR ...] [--only NAME ...]
 
 A study file (YAML, e.g. configs/studies/generic_artery_sensitivity.yaml) has the keys
   base     the scene, relative to the study file
   common   optional {dotted.key.path: value}, applied to every run, the baseline included (e.g. a
            coarser mesh)
   changes  a list of {name, set: {dotted.key.path: value}}: one run each, the baseline plus `set`
-Dotted key paths as in scripts/stability.py (scene_variant.apply_set): each value replaces the
+Dotted key paths as in bench/stability.py (scene_variant.apply_set): each value replaces the
 base's, a map or list as a whole (to change one layer of artery.mesh.layers, give the whole list).
 
 Outputs of each run (work_precision.outputs_of, from scripts/report.py's results.json): stent
@@ -36,8 +36,9 @@ import sys
 
 import yaml
 
-from scene_variant import SetError, apply_set
-from work_precision import ROOT, reused_run_dir, run_scene, scene_key
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts"))  # the tools
+from scene_variant import SetError, apply_set  # noqa: E402
+from work_precision import ROOT, reused_run_dir, run_scene, scene_key  # noqa: E402
 
 STUDY_KEYS = ("base", "common", "changes")
 CHANGE_KEYS = ("name", "set")

@@ -6,7 +6,7 @@ Starts `transport_latency_bench server` (listening) and `transport_latency_bench
 round-trip times for requests carrying 1,000 and 10,000 3-vectors of doubles (24 kB and
 240 kB, echoed back). Standard library only.
 
-    python3 scripts/bench_transport_latency.py --build-dir build-transport
+    python3 bench/bench_transport_latency.py --build-dir build-transport
 """
 import argparse
 import json

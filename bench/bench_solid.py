@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Wall time per Newton iteration of solid_solver for a scene, ranks and PETSc solver options.
 
-  scripts/bench_solid.py --exe build-solid/bin/solid_solver --scene configs/solid_artery_blood_pressure.yaml \
+  bench/bench_solid.py --exe build-solid/bin/solid_solver --scene configs/solid_artery_blood_pressure.yaml \
       --ranks 1 2 --steps 2
 
 Runs the scene with `time.steps` and `time.end` scaled to the given number of steps and each solver

@@ -2,7 +2,7 @@
 """Bow of a curved balloon's axis over a run: does the balloon, the driver of the stent, straighten
 as a whole or only in its halves? (paper §3.2: the device "straightens when the balloon inflates").
 
-  scripts/balloon_axis_bow.py RUN_DIR [--offset 0.75]
+  bench/balloon_axis_bow.py RUN_DIR [--offset 0.75]
 
 Reads RUN_DIR/solid/solid.h5 (every stored step) and the scene's balloon centerline. The balloon's
 nodes are grouped into stations by their reference arc length along that centerline; the centroid
