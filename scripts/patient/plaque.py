@@ -37,7 +37,8 @@ class PlaqueRegion:
 
 
 def plaque_types():
-    """{type: {E, nu, source}} from plaque_types.yaml (the one declaration of their parameters)."""
+    """{type: {E, nu}} from plaque_types.yaml (the one declaration of their parameters; their sources
+    are the comments there)."""
     import yaml
 
     with open(TYPES_FILE) as f:
