@@ -63,7 +63,7 @@ def render(run, views, artery_blocks, out_names):
             on = np.isin(block, list(artery_blocks))
             if on.any():
                 faces.extend(list(boundary_faces(conn[on][:, : (8 if et == "hex8" else 4)], et)))
-        if not faces:
+        if not faces or "/steps" not in f or not len(f["/steps"]):  # no artery, or no step written (a stop at step 1)
             return written
         nodes = np.unique(np.concatenate([np.asarray(fc) for fc in faces]))
         c, axis, normal = cut_frame(X[nodes])

@@ -5,7 +5,7 @@ Exact counts: the boundary of a structured hex8 tube (n_circ x n_axial x n_radia
 2 n_circ n_axial faces on its inner and outer surfaces and 2 n_circ n_radial on its ends; two tets
 sharing a face have 6 boundary faces. The cut plane of a straight tube contains its axis, and
 the far half holds half the boundary faces. render() writes one PNG per view from a run directory
-with solid.h5 (and without beam output).
+with solid.h5 (and without beam output), and none, without an error, when no step was written.
 Usage: test_artery_views.py   (a few seconds)
 """
 import os
@@ -58,6 +58,18 @@ class ArteryViews(unittest.TestCase):
         faces = boundary_faces(conn, "hex8")
         far = [f for f in faces if (X[f].mean(axis=0) - c) @ normal < 0]
         self.assertAlmostEqual(len(far) / len(faces), 0.5, delta=2 / NC)
+
+    def test_no_step_written_no_picture(self):
+        """A run stopped before its first output step: no picture, no error."""
+        X, conn = hex_tube()
+        with tempfile.TemporaryDirectory() as tmp:
+            run = Path(tmp)
+            (run / "solid").mkdir()
+            with h5py.File(run / "solid" / "solid.h5", "w") as f:
+                f["/mesh/coordinates"] = X
+                f["/mesh/hex8/connectivity"] = conn
+                f["/mesh/hex8/block_id"] = np.zeros(len(conn), dtype=np.int32)
+            self.assertEqual(render(run, [("peak", 1.0)], {0: "media"}, ["a.png"]), [])
 
     def test_render_writes_the_views(self):
         X, conn = hex_tube()
