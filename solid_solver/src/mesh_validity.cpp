@@ -11,26 +11,28 @@ namespace angio::solid {
 std::string first_invalid_element(const Mesh& m) {
   Eigen::VectorXd N;
   Eigen::MatrixXd dN, X;
+  // the reference nodes per element type, once (indexed by ElemType: Hex8, Tet4, Tet10)
+  const std::vector<Vec3d> nodes_of[] = {reference_nodes(ElemType::Hex8), reference_nodes(ElemType::Tet4),
+                                         reference_nodes(ElemType::Tet10)};
   for (size_t e = 0; e < m.elements.size(); ++e) {
     const auto& el = m.elements[e];
     X.resize(el.nn(), 3);
     for (int a = 0; a < el.nn(); ++a) X.row(a) = m.X[el.n[a]].transpose();
-    auto bad_at = [&](const double* xi) {
+    auto det_at = [&](const double* xi) {
       shape(el.type, xi, N, dN);
-      const double d = (X.transpose() * dN).determinant();
-      return std::isfinite(d) && d > 0.0 ? 0.0 : (std::isfinite(d) ? d : std::nan(""));
+      return (X.transpose() * dN).determinant();
     };
     double detJ = 0.0;
     std::string where;
     for (const auto& qp : volume_rule(el.type))
-      if ((detJ = bad_at(qp.xi)) != 0.0) {
+      if (!((detJ = det_at(qp.xi)) > 0.0)) {  // zero, negative or NaN
         where = "a Gauss point";
         break;
       }
     if (where.empty()) {
-      const auto nodes = reference_nodes(el.type);
+      const auto& nodes = nodes_of[int(el.type)];
       for (size_t a = 0; a < nodes.size(); ++a)
-        if ((detJ = bad_at(nodes[a].data())) != 0.0) {
+        if (!((detJ = det_at(nodes[a].data())) > 0.0)) {
           where = "its local node " + std::to_string(a);
           break;
         }

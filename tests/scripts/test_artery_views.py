@@ -42,6 +42,23 @@ def hex_tube(ri=1.0, ro=1.5, length=4.0):
     return X, np.array(conn)
 
 
+def solid_run(run, times):
+    """A run directory whose solid.h5 holds the hex tube (block 0, "media") and one output step per
+    time: a radial displacement and a nodal stress growing along z."""
+    X, conn = hex_tube()
+    (run / "solid").mkdir()
+    with h5py.File(run / "solid" / "solid.h5", "w") as f:
+        f["/mesh/coordinates"] = X
+        f["/mesh/hex8/connectivity"] = conn
+        f["/mesh/hex8/block_id"] = np.zeros(len(conn), dtype=np.int32)
+        for k, t in enumerate(times):
+            g = f.create_group(f"/steps/{k}")
+            g.attrs["time"] = t
+            g["displacement"] = 0.1 * t * X * np.array([1, 1, 0])
+            g["stress_p1_nodal_media"] = X[:, 2] + t
+    return run
+
+
 class ArteryViews(unittest.TestCase):
     def test_boundary_faces_counted_exactly(self):
         X, conn = hex_tube()
@@ -61,30 +78,13 @@ class ArteryViews(unittest.TestCase):
 
     def test_no_step_written_no_picture(self):
         """A run stopped before its first output step: no picture, no error."""
-        X, conn = hex_tube()
         with tempfile.TemporaryDirectory() as tmp:
-            run = Path(tmp)
-            (run / "solid").mkdir()
-            with h5py.File(run / "solid" / "solid.h5", "w") as f:
-                f["/mesh/coordinates"] = X
-                f["/mesh/hex8/connectivity"] = conn
-                f["/mesh/hex8/block_id"] = np.zeros(len(conn), dtype=np.int32)
+            run = solid_run(Path(tmp), times=())
             self.assertEqual(render(run, [("peak", 1.0)], {0: "media"}, ["a.png"]), [])
 
     def test_render_writes_the_views(self):
-        X, conn = hex_tube()
         with tempfile.TemporaryDirectory() as tmp:
-            run = Path(tmp)
-            (run / "solid").mkdir()
-            with h5py.File(run / "solid" / "solid.h5", "w") as f:
-                f["/mesh/coordinates"] = X
-                f["/mesh/hex8/connectivity"] = conn
-                f["/mesh/hex8/block_id"] = np.zeros(len(conn), dtype=np.int32)
-                for k, t in enumerate((1.0, 2.0)):
-                    g = f.create_group(f"/steps/{k}")
-                    g.attrs["time"] = t
-                    g["displacement"] = 0.1 * t * X * np.array([1, 1, 0])
-                    g["stress_p1_nodal_media"] = X[:, 2] + t
+            run = solid_run(Path(tmp), times=(1.0, 2.0))
             names = render(run, [("peak", 1.0), ("after", 2.0)], {0: "media"}, ["a.png", "b.png"])
             self.assertEqual(names, ["a.png", "b.png"])
             for n in names:

@@ -314,6 +314,22 @@ TEST(MeshValidity, InvertedAndFoldedElementsFound) {
   const std::string fold = first_invalid_element(folded);
   EXPECT_NE(fold.find("element 3 "), std::string::npos) << fold;
   EXPECT_NE(fold.find("inverted or degenerate"), std::string::npos) << fold;
+  // degenerate: a corner moved into the plane of the other three (det J exactly 0 for a straight tet)
+  Mesh flat = m;
+  Element& f = flat.elements[5];
+  for (int a = 4; a < 10; ++a) {  // straight edges: mid-edge nodes at the midpoints
+    static constexpr int kEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
+    flat.X[f.n[a]] = 0.5 * (flat.X[f.n[kEdge[a - 4][0]]] + flat.X[f.n[kEdge[a - 4][1]]]);
+  }
+  flat.X.push_back(flat.X[f.n[0]] + 0.5 * (flat.X[f.n[1]] - flat.X[f.n[0]]) + 0.25 * (flat.X[f.n[2]] - flat.X[f.n[0]]));
+  f.n[3] = int(flat.X.size()) - 1;
+  for (int a : {7, 8, 9}) {  // the edges to corner 3 follow it
+    static constexpr int kOther[3] = {0, 2, 1};
+    flat.X.push_back(0.5 * (flat.X[f.n[3]] + flat.X[f.n[kOther[a - 7]]]));
+    f.n[a] = int(flat.X.size()) - 1;
+  }
+  const std::string flat_what = first_invalid_element(flat);
+  EXPECT_NE(flat_what.find("element 5 "), std::string::npos) << "a flat tet10 is not found: " << flat_what;
   EXPECT_EQ(block_names(m), "media, adventitia");
   EXPECT_NE(surface_names(m, "artery_").find("inner"), std::string::npos);
 }
