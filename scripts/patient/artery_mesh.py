@@ -4,8 +4,10 @@ Wall: the lumen radius r and the total wall thickness per station (the centerlin
 column or one number). Media and adventitia have thicknesses proportional to the outer diameter
 D = 2 (r + wall) (paper §4.2.1, after Holzapfel et al. 2005, Am J Physiol Heart 289:H2048); the
 rest of the wall is intima. Each interface is a loft (OpenCASCADE ThruSections) through circles in
-the normal planes of the centerline stations; the four nested solids are fragmented into conforming
-layers and the lumen core removed.
+the normal planes of the centerline stations, or, from a lumen surface, through the surface's true
+sections and their radial offsets (periodic splines; lumen_sections.py), with the wall thickness
+varying around the vessel where the surface carries it; the four nested solids are fragmented into
+conforming layers and the lumen core removed.
 
 Physical groups (the names the solid solver and the scene use): volumes `intima`, `media`,
 `adventitia`; surfaces `endothelium` (lumen wall), `outer`, `end0` (first station), `end1`.
@@ -61,19 +63,67 @@ def resample(points, values, spacing):
 
 
 def layer_radii(r, wall, spec, where):
-    """Radii of the lumen, intima/media, media/adventitia and outer surfaces per station."""
-    D = 2.0 * (r + wall)
+    """Radii of the lumen, intima/media, media/adventitia and outer surfaces per station: (n, 4) from
+    one lumen radius and wall per station, or (n, 4, K) from the polar radius and wall along K rays
+    of a non-circular section (lumen_sections.py). Media and adventitia keep one thickness per
+    station, from the outer diameter of the section's area-equivalent circle (A = 1/2 int rho^2
+    dtheta); the intima takes the rest, so an eccentric wall is an eccentric intima."""
+    r, wall = np.asarray(r, dtype=float), np.asarray(wall, dtype=float)
+    polar = r.ndim == 2
+    r_eq = np.sqrt(np.mean(r**2, axis=1)) if polar else r
+    D = 2.0 * (r_eq + (wall.mean(axis=1) if polar else wall))
     tm = spec.media_ratio * D
     ta = spec.adventitia_ratio * D
-    ti = wall - tm - ta
-    k = int(np.argmin(ti))
-    if ti[k] < spec.min_intima:
+    tm_k, ta_k = (tm[:, None], ta[:, None]) if polar else (tm, ta)
+    ti = wall - tm_k - ta_k
+    k = int(np.unravel_index(np.argmin(ti), ti.shape)[0])
+    if ti.min() < spec.min_intima:
         raise PatientInputError(
-            f"{where}: the wall ({wall[k]:.3f} mm at station {k}) is too thin for media ({tm[k]:.3f} mm) and "
+            f"{where}: the wall ({wall[k].min():.3f} mm at station {k}) is too thin for media ({tm[k]:.3f} mm) and "
             f"adventitia ({ta[k]:.3f} mm) with an intima of at least {spec.min_intima:g} mm: expected a thicker wall "
             f"or smaller media_ratio/adventitia_ratio"
         )
-    return np.column_stack([r, r + ti, r + ti + tm, r + wall]), ti, tm, ta
+    return np.stack([r, r + ti, r + ti + tm_k, r + wall], axis=1), ti, tm, ta
+
+
+def _interp_rows(x, xp, A):
+    """A (n, ...) interpolated linearly along its first axis from xp to x."""
+    flat = A.reshape(len(xp), -1)
+    out = np.column_stack([np.interp(x, xp, flat[:, j]) for j in range(flat.shape[1])])
+    return out.reshape((len(x),) + A.shape[1:])
+
+
+def _polar_at(R, angles):
+    """A section's radius at `angles`: R a number (a circle) or K samples at 2 pi k / K (periodic linear)."""
+    if np.ndim(R) == 0:
+        return np.full(len(angles), float(R))
+    K = len(R)
+    th = 2.0 * math.pi * np.arange(K + 1) / K
+    return np.interp(np.mod(angles, 2.0 * math.pi), th, np.append(R, R[0]))
+
+
+def _section_curves(occ, center, p, n1, n2, R, a0=0.0, a1=None):
+    """The curves of one section around `center` (a point tag at p) in the plane (n1, n2): the closed
+    curve of radius R (a number: four circle arcs; K samples: a periodic spline through them), or for
+    a1 given the pie slice a0..a1 (lines to the center and the arc or spline between)."""
+    closed = a1 is None
+    if np.ndim(R) == 0:
+        if closed:
+            angles = a0 + 0.5 * math.pi * np.arange(4)
+        else:  # arcs of at most 90 degrees (OCC's circle arcs must stay below 180)
+            angles = np.linspace(a0, a1, max(1, math.ceil((a1 - a0) / (0.5 * math.pi) - 1e-9)) + 1)
+    else:
+        step = 2.0 * math.pi / len(R)
+        angles = (
+            a0 + step * np.arange(len(R)) if closed else np.linspace(a0, a1, max(2, math.ceil((a1 - a0) / step)) + 1)
+        )
+    rad = _polar_at(R, angles)
+    q = [occ.addPoint(*(p + rr * (math.cos(a) * n1 + math.sin(a) * n2))) for a, rr in zip(angles, rad)]
+    if np.ndim(R) == 0:
+        rim = [occ.addCircleArc(q[k], center, q[(k + 1) % len(q)]) for k in range(len(q) if closed else len(q) - 1)]
+    else:
+        rim = [occ.addSpline(q + [q[0]] if closed else q)]
+    return rim if closed else [occ.addLine(center, q[0])] + rim + [occ.addLine(q[-1], center)]
 
 
 def _sector_solids(occ, regions, s, P, t, n1, radii):
@@ -114,22 +164,14 @@ def _pie_loft(occ, reg, s, P, t, n1, radii, radius_of):
     nk -= np.einsum("ij,ij->i", nk, tk)[:, None] * tk
     nk /= np.linalg.norm(nk, axis=1)[:, None]
     bk = np.cross(tk, nk)
-    R = radius_of(*(np.interp(ss, s, radii[:, j]) for j in range(3)))
+    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(3)))
     a0, a1 = (math.radians(a) for a in reg.angle)
-    if reg.full_circle:
-        angles = a0 + 0.5 * math.pi * np.arange(4)
-    else:  # arcs of at most 90 degrees (OCC's circle arcs must stay below 180)
-        angles = np.linspace(a0, a1, max(1, math.ceil((a1 - a0) / (0.5 * math.pi) - 1e-9)) + 1)
     wires = []
     for i in range(len(ss)):
         c = occ.addPoint(*Pk[i])
-        q = [occ.addPoint(*(Pk[i] + R[i] * (math.cos(a) * nk[i] + math.sin(a) * bk[i]))) for a in angles]
-        if reg.full_circle:
-            edges = [occ.addCircleArc(q[k], c, q[(k + 1) % 4]) for k in range(4)]
-        else:
-            arcs = [occ.addCircleArc(q[k], c, q[k + 1]) for k in range(len(q) - 1)]
-            edges = [occ.addLine(c, q[0])] + arcs + [occ.addLine(q[-1], c)]
-        wires.append(occ.addWire(edges))
+        wires.append(
+            occ.addWire(_section_curves(occ, c, Pk[i], nk[i], bk[i], R[i], a0, None if reg.full_circle else a1))
+        )
     return occ.addThruSections(wires, makeSolid=True, makeRuled=False)
 
 
@@ -145,15 +187,24 @@ def build_artery(
     where="patient",
     log=print,
     plaque=(),
+    sections=None,
 ):
     """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts. `plaque`: the
-    regions of the intima with their own volume group (plaque.PlaqueRegion, checked)."""
+    regions of the intima with their own volume group (plaque.PlaqueRegion, checked). `sections`: a
+    lumen_sections.LumenSections whose true sections replace the circles of `radius` (and whose
+    wall-thickness field, if it has one, replaces `wall`)."""
     import gmsh
 
     s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
-    radii, ti, tm, ta = layer_radii(r, w, spec, where)
     t, n1 = rotation_minimizing_normals(P)
     n2 = np.cross(t, n1)
+    if sections is not None:
+        from .lumen_sections import low_pass
+
+        polar = [sections.polar(P[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(P))]
+        r = low_pass([rho for rho, _ in polar])
+        w = low_pass([f for _, f in polar]) if sections.field is not None else np.repeat(w[:, None], r.shape[1], 1)
+    radii, ti, tm, ta = layer_radii(r, w, spec, where)
     gmsh.initialize()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
@@ -164,13 +215,7 @@ def build_artery(
             wires = []
             for i in range(len(P)):
                 c = occ.addPoint(*P[i])
-                R = radii[i, layer]
-                q = [
-                    occ.addPoint(*(P[i] + R * (math.cos(a) * n1[i] + math.sin(a) * n2[i])))
-                    for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)
-                ]
-                arcs = [occ.addCircleArc(q[k], c, q[(k + 1) % 4]) for k in range(4)]
-                wires.append(occ.addWire(arcs))
+                wires.append(occ.addWire(_section_curves(occ, c, P[i], n1[i], n2[i], radii[i, layer])))
             vol = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
             solids.append([dt for dt in vol if dt[0] == 3])
         all_in = [dt for sl in solids for dt in sl]
@@ -273,6 +318,8 @@ def build_artery(
             "straightened_tet10": int(straightened),
             "min_scaled_jacobian": _min_scaled_jacobian(),
             "stations": int(len(P)),
+            "sections": "circles" if r.ndim == 1 else f"lumen surface, {r.shape[1]} rays",
+            "lumen_aspect_max": float(np.max(r.max(axis=1) / r.min(axis=1))) if r.ndim == 2 else 1.0,
             "thickness_range": {
                 "intima": [float(ti.min()), float(ti.max())],
                 "media": [float(tm.min()), float(tm.max())],
@@ -285,9 +332,13 @@ def build_artery(
     except Exception as e:
         if type(e) is not Exception:  # a bug of ours, not gmsh's verdict on the geometry
             raise
-        # gmsh's Python API raises a bare Exception when it cannot build or mesh the geometry
+        # gmsh's Python API raises a bare Exception when it cannot build or mesh the geometry; the usual
+        # cause is a layer much thinner than the elements, whose two surface meshes then cross
+        thinnest = min((float(np.min(v)), name) for v, name in ((ti, "intima"), (tm, "media"), (ta, "adventitia")))
         raise PatientInputError(
-            f"{where}: gmsh cannot mesh the artery from this centerline: " f"{' '.join(str(e).split())}"
+            f"{where}: gmsh cannot mesh the artery from this centerline: {' '.join(str(e).split())} (the "
+            f"thinnest layer, the {thinnest[1]}, is {thinnest[0]:.3f} mm against a mesh size of {mesh_size:g} mm: "
+            "a smaller patient.mesh.size or a thicker wall may mesh)"
         ) from e
     finally:
         gmsh.finalize()

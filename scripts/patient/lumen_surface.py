@@ -25,6 +25,7 @@ class LumenSurface:
     points: np.ndarray  # (n, 3) mm
     triangles: np.ndarray  # (m, 3) vertex ids, consistently oriented
     loops: list  # two arrays of vertex ids, each a boundary loop in order
+    scale: float = 1.0  # mm per unit of the file
 
 
 def read_lumen_surface(path, units="mm"):
@@ -65,7 +66,7 @@ def read_lumen_surface(path, units="mm"):
             + (" (a closed surface: cut its ends open)" if not loops else "")
             + (" (side branches or holes: cut branches off and close holes)" if len(loops) > 2 else "")
         )
-    return LumenSurface(path, points, triangles, loops)
+    return LumenSurface(path, points, triangles, loops, UNITS[units])
 
 
 def merge_vertices(points, triangles, tol=1e-9):

@@ -122,11 +122,21 @@ def plaque_materials(regions, layers, scene_path):
 
 def check_within_intima(regions, s, intima, scene_path):
     """Each region's thickness leaves at least MIN_INTIMA_LEFT of intima outside it, at every
-    station s (mm) of its stretch; `intima` the intima's thickness per station."""
+    station s (mm) of its stretch; `intima` the intima's thickness per station (n,), or per station
+    and ray (n, K) with ray k at 360 k / K degrees, of which the rays in the region's sector count."""
+    intima_all = np.asarray(intima, dtype=float)
     for k, r in enumerate(regions):
         depth = r.offset + (r.thickness or 0.0)
         if depth == 0.0:
             continue
+        intima = intima_all
+        if intima_all.ndim == 2:
+            rays = 360.0 * np.arange(intima_all.shape[1]) / intima_all.shape[1]
+            off = np.mod(rays - r.angle[0], 360.0)
+            inside = off <= r.angle[1] - r.angle[0] + 1e-9
+            if not inside.any():  # a sector narrower than the rays' spacing: its nearest ray
+                inside = off == off[np.argmin(np.minimum(off, 360.0 - off))]
+            intima = intima_all[:, inside].min(axis=1)
         on = (s >= r.from_s) & (s <= r.to_s)
         ends = np.interp([r.from_s, r.to_s], s, intima)
         thin = np.concatenate([intima[on], ends])

@@ -11,6 +11,7 @@ the run directory. A placement.json records what was done (spline knots, eq. (3)
   /usr/bin/python3 -m patient.prepare SCENE OUT_DIR     (from scripts/; the launcher calls prepare_scene)
 """
 import copy
+import dataclasses
 import json
 import math
 import shutil
@@ -21,10 +22,11 @@ import numpy as np
 import insertion_tool
 import scene_keys
 
-from .artery_mesh import WallSpec, build_artery, layer_radii
+from .artery_mesh import WallSpec, build_artery, layer_radii, rotation_minimizing_normals
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
+from .lumen_sections import LumenSections, read_wall_field
 from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 from .plaque import check_within_intima, plaque_materials, read_plaque
@@ -140,8 +142,9 @@ def add_insertion(done, plc, dev, ins, scene_path):
 
 
 def lumen_csv(pat, scene_path, out_dir, log):
-    """The lumen centerline CSV of the scene: patient.centerline as given, or the one computed from
-    patient.lumen_surface into out_dir/lumen_from_surface.csv."""
+    """(CSV, sections) of the scene: patient.centerline as given, or the one computed from
+    patient.lumen_surface into out_dir/lumen_from_surface.csv with the surface's true sections
+    (lumen_sections.LumenSections, None for circles)."""
     given = [k for k in ("centerline", "lumen_surface") if pat[k]]
     if len(given) != 1:
         raise PatientInputError(
@@ -149,7 +152,7 @@ def lumen_csv(pat, scene_path, out_dir, log):
             f"({{file, units}}), got {' and '.join(given) or 'neither'}"
         )
     if pat["centerline"]:
-        return (scene_path.parent / pat["centerline"]).resolve()
+        return (scene_path.parent / pat["centerline"]).resolve(), None
     spec = scene_keys.check_map(pat["lumen_surface"], "patient.lumen_surface", scene_path, PatientInputError)
     path = (scene_path.parent / spec["file"]).resolve()
     surface = read_lumen_surface(str(path), spec["units"])
@@ -159,7 +162,28 @@ def lumen_csv(pat, scene_path, out_dir, log):
         out, points, radius, comment=f"lumen centerline of {path} (scripts/patient/lumen_centerline.py)"
     )
     log(f"patient: lumen surface {path.name}: {len(surface.triangles)} triangles -> {len(points)} centerline stations")
-    return out
+    from_surface = (pat["wall"] or {}).get("thickness") == "from_surface"
+    if spec["sections"] == "circles":
+        if from_surface:
+            raise PatientInputError(
+                f"{scene_path}: patient.wall.thickness: from_surface needs patient.lumen_surface.sections: surface"
+            )
+        return out, None
+    field = read_wall_field(str(path), surface, spec["wall_array"]) if from_surface else None
+    return out, LumenSections(surface, field, spec["wall_array"] if from_surface else None)
+
+
+def station_sections(cl, sections):
+    """Per centerline station of cl: the sections' polar lumen radius and wall field (n, K) (the
+    field None without one) and the clearance radius (n,), in the loft's frames."""
+    t, n1 = rotation_minimizing_normals(cl.points)
+    n2 = np.cross(t, n1)
+    s = cl.arc_length
+    polar = [sections.polar(cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
+    clear = [sections.clearance_radius(cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
+    rho = np.array([r for r, _ in polar])
+    field = np.array([f for _, f in polar]) if sections.field is not None else None
+    return rho, field, np.array(clear)
 
 
 def prepare_scene(scene, scene_path, out_dir, log=print):
@@ -180,8 +204,13 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         )
     dev = device_of(scene, scene_path)
 
-    csv_path = lumen_csv(pat, scene_path, Path(out_dir), log)
+    csv_path, sections = lumen_csv(pat, scene_path, Path(out_dir), log)
     cl = read_centerline_csv(csv_path)
+    if wall["thickness"] == "from_surface" and not pat["lumen_surface"]:
+        raise PatientInputError(
+            f"{scene_path}: patient.wall.thickness: from_surface needs patient.lumen_surface (a surface with a "
+            "wall-thickness point array); with a centerline CSV use from_centerline or a number"
+        )
     if wall["thickness"] == "from_centerline":
         if pat["lumen_surface"]:
             raise PatientInputError(
@@ -194,13 +223,25 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
                 f"has no `wall` column (or add the column)"
             )
         wall_t = cl.wall
+    elif wall["thickness"] == "from_surface":
+        wall_t = None  # from the surface's field, per ray (below)
     else:
         wall_t = np.full(len(cl.radius), float(wall["thickness"]))
+    # the lumen and wall per station as the mesh will have them: the true sections (n, K) when the
+    # surface gives them; the devices must then clear the largest circle inside each section
+    # around its centerline point, not the area-equivalent one
+    r_lumen, w_lumen, cl_fit = cl.radius, wall_t, cl
+    if sections is not None:
+        r_lumen, field, r_clear = station_sections(cl, sections)
+        w_lumen = field if field is not None else np.repeat(wall_t[:, None], r_lumen.shape[1], 1)
+        if wall_t is None:
+            wall_t = w_lumen.mean(axis=1)
+        cl_fit = dataclasses.replace(cl, radius=r_clear)
     s_site = stenosis_site(
         cl, None if pat["stenosis"] == "auto" else float(pat["stenosis"]), where=f"{scene_path}: patient.stenosis"
     )
-    insertion = ins["mode"] == "auto" and not devices_fit(cl, dev, s_site, margin=spl["clearance"])
-    plc = place_device(cl, dev, s_site, zeta=spl["smoothing"], margin=spl["clearance"], insertion=insertion)
+    insertion = ins["mode"] == "auto" and not devices_fit(cl_fit, dev, s_site, margin=spl["clearance"])
+    plc = place_device(cl_fit, dev, s_site, zeta=spl["smoothing"], margin=spl["clearance"], insertion=insertion)
     out = Path(out_dir)
     dev_file = out / "device_centerline.txt"
     lumen_file = out / "lumen_centerline.txt"
@@ -209,7 +250,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     )
     plaque = read_plaque(pat["plaque"], float(cl.arc_length[-1]), scene_path)
     if plaque:
-        check_within_intima(plaque, cl.arc_length, layer_radii(cl.radius, wall_t, spec, str(csv_path))[1], scene_path)
+        check_within_intima(plaque, cl.arc_length, layer_radii(r_lumen, w_lumen, spec, str(csv_path))[1], scene_path)
     layers = artery.get("layers")
     if not isinstance(layers, dict):
         raise PatientInputError(
@@ -236,8 +277,9 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         # the tool stretches the innermost layer most: elements larger than it is thick invert there
         # (measured on the CI lesion, a 0.94 mm lumen in a 1.0 mm wall with a 0.63 mm intima: mesh.size
         # 1.0 stops where the artery contacts switch on, 0.5 runs)
-        _, ti, _, _ = layer_radii(cl.radius, wall_t, spec, str(csv_path))
+        _, ti, _, _ = layer_radii(r_lumen, w_lumen, spec, str(csv_path))
         k = int(np.argmin(np.abs(cl.arc_length - s_site)))
+        ti = ti if ti.ndim == 1 else ti.min(axis=1)
         if mesh["size"] > ti[k]:
             log(
                 f"patient: warning: patient.mesh.size {mesh['size']:g} mm is larger than the intima at the lesion "
@@ -256,7 +298,8 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         f"{plc.clearance_stent:.3f} mm"
     )
     log(
-        f"patient: stenosis at {s_site:.2f} mm (lumen diameter {2 * plc.site_radius:.3f} mm); {fit}; meshing "
+        f"patient: stenosis at {s_site:.2f} mm (lumen diameter {2 * np.interp(s_site, cl.arc_length, cl.radius):.3f} mm"
+        f"{f', inscribed {2 * plc.site_radius:.3f} mm' if sections is not None else ''}); {fit}; meshing "
         f"the artery (size {mesh['size']:g} mm)"
     )
     info = build_artery(
@@ -271,6 +314,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         where=str(csv_path),
         log=log,
         plaque=plaque,
+        sections=sections,
     )
     log(
         f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs), minimal scaled "
@@ -281,7 +325,18 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         "points": int(len(cl.radius)),
         "lumen_length": float(cl.arc_length[-1]),
         "lumen_diameter_range": [float(2 * cl.radius.min()), float(2 * cl.radius.max())],
-        "placement": plc.report(),
+        "lumen_sections": (
+            None
+            if sections is None
+            else {
+                "rays": int(r_lumen.shape[1]),
+                "inscribed_diameter_range": [float(2 * cl_fit.radius.min()), float(2 * cl_fit.radius.max())],
+                "aspect_max": float(np.max(r_lumen.max(axis=1) / r_lumen.min(axis=1))),
+                "wall_range": [float(w_lumen.min()), float(w_lumen.max())],
+                "wall_from": "surface" if sections.field is not None else "patient.wall.thickness",
+            }
+        ),
+        "placement": plc.report(),  # with sections, its lumen_diameter is the inscribed one (what the devices clear)
         "insertion": ins_report,
         "artery_mesh": info,
         "plaque": [

@@ -1,0 +1,160 @@
+"""The true cross-sections of a lumen surface (lumen_surface.py) at the stations of the artery's loft:
+the surface cut by the normal plane of the centerline at a station, as the polar radius rho(theta) of
+the cut around the station point, sampled at ANGLES equally spaced angles from the frame's first normal
+(the rotation-minimizing normal of artery_mesh.py, so successive sections start at corresponding
+points and the loft does not twist). A wall-thickness field given on the surface's vertices (a point
+data array) is sampled on the same rays. Units: mm.
+
+Each wall interface is then the lumen section moved outward along the same rays (artery_mesh.py):
+interfaces of a star-shaped section moved radially never cross each other, whatever the thickness,
+which is what makes the layered wall robust on eccentric and elliptic lumens. The thickness so
+measured is radial, not normal to the lumen; for an ellipse of aspect ratio 1.5 the two differ by at
+most 10 % at the flanks. A section that is not star-shaped around its station point (a ray leaving the
+lumen twice: a kink, a fold, a bifurcation remnant) is refused."""
+import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
+
+from .errors import PatientInputError
+
+ANGLES = 48  # samples per section: 7.5 degrees apart, below the artery mesh's element size around
+# The loft's splines go through fewer points: gmsh's second-order pass (projecting mid-edge nodes onto
+# the lofted spline surfaces) grows with their poles: measured on an elliptic tube, mesh size 0.8 mm,
+# 4.3k tet10, 176 s with 48 points against 31 s with 16 (circles: 7 s).
+SPLINE_POINTS = 16
+
+
+def low_pass(samples, points=SPLINE_POINTS):
+    """Periodic samples (..., ANGLES) reduced to `points` equally spaced ones (the first at angle 0)
+    through their Fourier series truncated below points / 2 harmonics: no aliasing of the facets'
+    jitter into the spline."""
+    x = np.asarray(samples, dtype=float)
+    n = x.shape[-1]
+    if n % points:
+        raise ValueError(f"{n} samples do not reduce to {points}")
+    c = np.fft.rfft(x, axis=-1)
+    c[..., (points - 1) // 2 + 1 :] = 0.0
+    return np.fft.irfft(c, n=n, axis=-1)[..., :: n // points]
+
+
+def _cross2(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+class LumenSections:
+    """Sections of one lumen surface; `field` an optional per-vertex array (e.g. the wall thickness)."""
+
+    def __init__(self, surface, field=None, field_name=None):
+        self.surface = surface
+        self.field = None if field is None else np.asarray(field, dtype=float)
+        self.field_name = field_name
+
+    def _cut(self, P, t):
+        """The segments of the plane cut (2 points each, and the field at them) of the loop around P."""
+        X, T = self.surface.points, self.surface.triangles
+        d = (X - P) @ t
+        above = d[T] > 0.0
+        cut = np.flatnonzero(above.any(axis=1) & ~above.all(axis=1))
+        if not len(cut):
+            return None
+        ends, keys, vals = [], [], []
+        for k in range(3):
+            a, b = T[cut, k], T[cut, (k + 1) % 3]
+            cross = above[cut, k] != above[cut, (k + 1) % 3]
+            u = np.where(cross, d[a] / np.where(cross, d[a] - d[b], 1.0), 0.0)
+            ends.append(np.where(cross[:, None], X[a] + u[:, None] * (X[b] - X[a]), np.nan))
+            keys.append(np.where(cross, np.minimum(a, b) * len(X) + np.maximum(a, b), -1))
+            f = self.field if self.field is not None else np.zeros(len(X))
+            vals.append(f[a] + u * (f[b] - f[a]))
+        ends, keys, vals = np.stack(ends, 1), np.stack(keys, 1), np.stack(vals, 1)
+        # each cut triangle crosses the plane on exactly two of its edges
+        order = np.argsort(keys < 0, axis=1, kind="stable")[:, :2]
+        rows = np.arange(len(cut))[:, None]
+        seg, key, val = ends[rows, order], keys[rows, order], vals[rows, order]
+        # loops: connected components of the segments through the mesh edges they cross
+        uniq, inv = np.unique(key, return_inverse=True)
+        inv = inv.reshape(-1, 2)
+        graph = scipy.sparse.coo_matrix((np.ones(len(inv)), (inv[:, 0], inv[:, 1])), shape=(len(uniq),) * 2)
+        _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
+        return seg, val, label[inv[:, 0]]
+
+    def polar(self, P, t, n1, n2, where, angles=ANGLES):
+        """(rho, field) at `angles` rays from P in the plane through P normal to t, theta from n1 towards
+        n2; PatientInputError (naming `where`) when the plane misses the lumen around P or a ray leaves
+        it more than once."""
+        got = self._cut(P, t)
+        if got is None:
+            raise PatientInputError(f"{self.surface.path}: the section at {where} does not cut the lumen surface")
+        seg, val, loop = got
+        a = np.stack([(seg[:, 0] - P) @ n1, (seg[:, 0] - P) @ n2], -1)
+        b = np.stack([(seg[:, 1] - P) @ n1, (seg[:, 1] - P) @ n2], -1)
+        theta = 2.0 * np.pi * np.arange(angles) / angles
+        e = np.stack([np.cos(theta), np.sin(theta)], -1)[:, None, :]
+        dab = (b - a)[None]
+        den = _cross2(e, dab)
+        ok_den = np.abs(den) > 1e-300
+        rho = np.where(ok_den, _cross2(a[None], dab) / np.where(ok_den, den, 1.0), np.nan)
+        u = np.where(ok_den, _cross2(a[None], e) / np.where(ok_den, den, 1.0), np.nan)
+        hit = ok_den & (u >= -1e-9) & (u <= 1.0 + 1e-9) & (rho > 0.0)
+        # the loop around P: the one the rays hit (a plane may cut the vessel again far away)
+        own = np.bincount(loop[hit.any(axis=0)], minlength=loop.max() + 1)
+        if not own.any():
+            raise PatientInputError(f"{self.surface.path}: the section at {where} does not enclose the centerline")
+        hit &= (loop == int(np.argmax(own)))[None]
+        out_rho, out_val = np.empty(angles), np.empty(angles)
+        for k in range(angles):
+            r = rho[k, hit[k]]
+            if not len(r):
+                raise PatientInputError(
+                    f"{self.surface.path}: the section at {where} is not star-shaped around its centerline point: the "
+                    f"ray at {np.degrees(theta[k]):.0f} degrees does not meet the lumen wall (the point lies outside a "
+                    "crescent- or C-shaped lumen, or the section is open)"
+                )
+            # hits at a vertex shared by two segments count once
+            distinct = np.unique(np.round(r / max(r.min(), 1e-12), 6))
+            if len(distinct) > 1:
+                raise PatientInputError(
+                    f"{self.surface.path}: the section at {where} is not star-shaped around its centerline point: the "
+                    f"ray at {np.degrees(theta[k]):.0f} degrees leaves the lumen {len(distinct)} times (a kink or a "
+                    "fold of the surface; smooth it or cut the vessel shorter)"
+                )
+            j = int(np.argmin(r))
+            seg_k = np.flatnonzero(hit[k])[j]
+            out_rho[k] = r[j]
+            uk = min(max(u[k, seg_k], 0.0), 1.0)
+            out_val[k] = val[seg_k, 0] + uk * (val[seg_k, 1] - val[seg_k, 0])
+        return out_rho, (out_val if self.field is not None else None)
+
+    def clearance_radius(self, P, t, n1, n2, where):
+        """The distance from P to the nearest point of its section (<= min rho): the radius of the
+        largest circle around P inside the lumen, what a device centered at P must clear."""
+        rho, _ = self.polar(P, t, n1, n2, where)
+        theta = 2.0 * np.pi * np.arange(len(rho)) / len(rho)
+        q = rho[:, None] * np.stack([np.cos(theta), np.sin(theta)], -1)
+        a, b = q, np.roll(q, -1, axis=0)
+        d = b - a
+        u = np.clip(-np.einsum("ij,ij->i", a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+        return float(np.min(np.linalg.norm(a + u[:, None] * d, axis=1)))
+
+
+def read_wall_field(surface_path, surface, name):
+    """The point-data array `name` of the surface file, on the merged vertices of `surface` (mm)."""
+    import meshio
+
+    mesh = meshio.read(surface_path)
+    if name not in mesh.point_data:
+        have = ", ".join(sorted(mesh.point_data)) or "none"
+        raise PatientInputError(
+            f"{surface_path}: expected a point data array '{name}' (the wall thickness, mm), got arrays: {have} "
+            "(STL carries none: write VTK, VTU or PLY)"
+        )
+    values = np.asarray(mesh.point_data[name], dtype=float)
+    if values.ndim != 1:
+        raise PatientInputError(f"{surface_path}: point data '{name}': expected one value per vertex")
+    if not np.all(np.isfinite(values)) or values.min() <= 0.0:
+        raise PatientInputError(f"{surface_path}: point data '{name}': expected positive finite thicknesses (mm)")
+    # the surface's merged vertices came from these points: each keeps the value of its nearest original
+    from scipy.spatial import cKDTree
+
+    _, idx = cKDTree(np.asarray(mesh.points, dtype=float)[:, :3] * surface.scale).query(surface.points)
+    return values[idx] * surface.scale

@@ -1,0 +1,195 @@
+#!/usr/bin/python3
+"""Non-circular lumens and walls of varying thickness from a lumen surface
+(scripts/patient/lumen_sections.py, artery_mesh.py with `sections`).
+
+Analytic checks on a straight elliptic tube along z (semi-axes A = 1.2 mm along x, B = 0.8 mm along y,
+its center shifted by E = 0.2 mm along +x, 96 facets around) carrying a wall-thickness point array
+w = W0 + W1 cos(theta) (theta around the tube, 0 along +x: a wall thicker on one side):
+- the sections' polar radius equals the ellipse's around the station point, and the thickness sampled
+  on the rays equals w, both within the facets' chord error (1 - cos(pi / 96) = 5e-4 relative);
+- the clearance radius (the largest circle around the station point inside the section) is the
+  ellipse's distance from its center point, B, within the chord error;
+- a C-shaped section around its centroid is refused, naming the station ("not star-shaped");
+- the meshed three-layer wall (tet10): its volume and its intima's equal the polar integrals
+  L/2 int (r_out^2 - r_in^2) dtheta of the radial offsets (media and adventitia thickness from the
+  area-equivalent outer diameter, as artery_mesh.layer_radii) within 1 %, and no element is inverted;
+- a thickness array the file does not have is refused naming it and the arrays it has.
+Usage: test_lumen_sections.py   (about 60 s)
+"""
+import os
+import shutil
+import sys
+import tempfile
+import unittest
+
+import meshio
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mesh_measures import tet10_volumes  # noqa: E402
+from patient.artery_mesh import WallSpec, build_artery  # noqa: E402
+from patient.errors import PatientInputError  # noqa: E402
+from patient.lumen_sections import LumenSections, read_wall_field  # noqa: E402
+from patient.lumen_surface import read_lumen_surface  # noqa: E402
+
+A, B, E, LENGTH = 1.2, 0.8, 0.2, 6.0
+W0, W1 = 1.0, 0.3
+NC, NA = 96, 30
+SPEC = WallSpec(media_ratio=0.06, adventitia_ratio=0.065, min_intima=0.05)
+
+
+def ellipse_tube(section=None):
+    """Points, triangles and wall thickness of the straight tube; section(phi) -> (x, y) overrides the ellipse."""
+    phi = 2 * np.pi * np.arange(NC) / NC
+    x, y = section(phi) if section else (E + A * np.cos(phi), B * np.sin(phi))
+    z = np.linspace(0.0, LENGTH, NA + 1)
+    pts = np.array([[x[j], y[j], zi] for zi in z for j in range(NC)])
+    tris = []
+    for i in range(NA):
+        for j in range(NC):
+            a, b, c, d = i * NC + j, i * NC + (j + 1) % NC, (i + 1) * NC + j, (i + 1) * NC + (j + 1) % NC
+            tris += [[a, b, d], [a, d, c]]
+    theta = np.arctan2(pts[:, 1], pts[:, 0] - E)
+    return pts, np.array(tris), W0 + W1 * np.cos(theta)
+
+
+def ellipse_rho(theta):
+    """Polar radius of the ellipse around its center."""
+    return A * B / np.sqrt((B * np.cos(theta)) ** 2 + (A * np.sin(theta)) ** 2)
+
+
+class LumenSections_(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="angio-sections-")
+        pts, tris, w = ellipse_tube()
+        cls.path = os.path.join(cls.tmp, "ellipse.vtk")
+        meshio.write(cls.path, meshio.Mesh(pts, [("triangle", tris)], point_data={"wall_thickness": w}))
+        cls.surface = read_lumen_surface(cls.path)
+        cls.sections = LumenSections(cls.surface, read_wall_field(cls.path, cls.surface, "wall_thickness"))
+        cls.frame = (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_polar_radius_and_thickness_on_the_rays(self):
+        t, n1, n2 = self.frame
+        for z in (0.05, 2.5, 5.95):
+            rho, w = self.sections.polar(np.array([E, 0.0, z]), t, n1, n2, f"z = {z}")
+            theta = 2 * np.pi * np.arange(len(rho)) / len(rho)
+            self.assertLess(np.max(np.abs(rho / ellipse_rho(theta) - 1)), 1e-3)
+            # w interpolated linearly along facets of the 96-gon: within the chord error of W1 cos
+            self.assertLess(np.max(np.abs(w - (W0 + W1 * np.cos(theta)))), 2e-3)
+
+    def test_clearance_radius_is_the_minor_semi_axis(self):
+        t, n1, n2 = self.frame
+        r = self.sections.clearance_radius(np.array([E, 0.0, 3.0]), t, n1, n2, "z = 3")
+        self.assertLess(abs(r / B - 1), 1e-3)
+        self.assertLess(r, ellipse_rho(np.linspace(0, 2 * np.pi, 97)).min() + 1e-9)
+
+    def test_a_c_shaped_section_is_refused(self):
+        def c_shape(phi):  # a ring band 0.7..1.0 from 30 to 330 deg: its centroid lies in the hole
+            u = np.concatenate([np.linspace(np.radians(30), np.radians(330), NC // 2)] * 2)
+            r = np.concatenate([np.full(NC // 2, 1.0), np.full(NC // 2, 0.7)])
+            order = np.concatenate([np.arange(NC // 2), NC // 2 + np.arange(NC // 2)[::-1]])
+            return (r * np.cos(u))[order], (r * np.sin(u))[order]
+
+        pts, tris, _ = ellipse_tube(c_shape)
+        path = os.path.join(self.tmp, "c.stl")
+        meshio.write(path, meshio.Mesh(pts, [("triangle", tris)]))
+        sections = LumenSections(read_lumen_surface(path))
+        t, n1, n2 = self.frame
+        with self.assertRaisesRegex(PatientInputError, r"c\.stl: the section at z = 3 .*not star-shaped"):
+            sections.polar(np.array([-0.2, 0.0, 3.0]), t, n1, n2, "z = 3")
+
+    def test_missing_thickness_array_is_refused(self):
+        with self.assertRaisesRegex(
+            PatientInputError, r"ellipse\.vtk: expected a point data array 'wall'.*wall_thickness"
+        ):
+            read_wall_field(self.path, self.surface, "wall")
+
+    def test_layered_wall_volumes(self):
+        z = np.linspace(0.01, LENGTH - 0.01, 13)  # inside the open ends, as a computed centerline is
+        points = np.column_stack([np.full_like(z, E), np.zeros_like(z), z])
+        r_eq = np.sqrt(A * B)
+        out = os.path.join(self.tmp, "wall.msh")
+        info = build_artery(
+            points, np.full_like(z, r_eq), np.full_like(z, W0), SPEC, 0.5, out, loft_spacing=0.5,
+            log=lambda m: None, sections=self.sections,
+        )  # fmt: skip
+        self.assertGreater(info["min_scaled_jacobian"], 0.0)
+        self.assertAlmostEqual(info["lumen_aspect_max"], A / B, delta=0.01)
+        m = meshio.read(out)
+        vol = {}
+        for name, tags in m.cell_sets_dict.items():
+            for ctype, idx in tags.items():
+                if ctype == "tetra10":
+                    conn = m.cells_dict["tetra10"][idx]
+                    vol[name] = tet10_volumes(np.asarray(m.points), conn).sum()
+        # exact: polar integrals of the radial offsets (dense quadrature)
+        th = np.linspace(0.0, 2 * np.pi, 4001)[:-1]
+        rho, w = ellipse_rho(th), W0 + W1 * np.cos(th)
+        D = 2 * (np.sqrt(np.mean(rho**2)) + np.mean(w))
+        ti = w - (SPEC.media_ratio + SPEC.adventitia_ratio) * D
+
+        def ring(r_in, r_out):
+            return (z[-1] - z[0]) * 0.5 * np.mean(r_out**2 - r_in**2) * 2 * np.pi
+
+        exact = {"intima": ring(rho, rho + ti), "wall": ring(rho, rho + w)}
+        total = vol["intima"] + vol["media"] + vol["adventitia"]
+        print(
+            f"intima {vol['intima'] / exact['intima'] - 1:+.2e}, wall {total / exact['wall'] - 1:+.2e}", file=sys.stderr
+        )
+        self.assertLess(abs(vol["intima"] / exact["intima"] - 1), 0.01, (vol, exact))
+        self.assertLess(abs(total / exact["wall"] - 1), 0.01, (vol, exact))
+
+    def test_patient_pipeline_with_the_wall_from_the_surface(self):
+        """patient.lumen_surface with wall.thickness from_surface: the report gives the sections' aspect
+        ratio, inscribed diameter (2 B) and wall range (W0 -+ W1); the balloon, on the axis, clears the
+        inscribed circle; keys that cannot go together are refused naming them."""
+        import yaml
+
+        from patient.prepare import prepare_scene
+
+        with open(os.path.join(ROOT, "configs", "patient_like.yaml")) as f:
+            scene = yaml.safe_load(f)
+        del scene["patient"]["centerline"]
+        scene["patient"]["lumen_surface"] = {"file": self.path}
+        scene["patient"]["wall"]["thickness"] = "from_surface"
+        scene["patient"]["stenosis"] = 3.0  # a uniform tube: its middle
+        scene["patient"]["mesh"]["size"] = 0.8
+        scene["balloon"]["mesh"].update(length=5.0, n_axial=34)
+        scene["stent"]["generator"].update(rings=2, ring_pitch=1.5)
+        scene_path = os.path.join(self.tmp, "scene.yaml")
+        out = os.path.join(self.tmp, "prepared")
+        os.makedirs(out, exist_ok=True)
+        _, report = prepare_scene(scene, scene_path, out, log=lambda m: None)
+        sec = report["lumen_sections"]
+        self.assertAlmostEqual(sec["aspect_max"], A / B, delta=0.01)
+        self.assertAlmostEqual(min(sec["inscribed_diameter_range"]), 2 * B, delta=0.01)
+        self.assertAlmostEqual(sec["wall_range"][0], W0 - W1, delta=0.01)
+        self.assertAlmostEqual(sec["wall_range"][1], W0 + W1, delta=0.01)
+        self.assertEqual(sec["wall_from"], "surface")
+        self.assertAlmostEqual(report["placement"]["clearance"]["balloon"], B - 0.49, delta=0.01)
+        self.assertGreater(report["artery_mesh"]["min_scaled_jacobian"], 0.0)
+        bad = [
+            ({"sections": "circles"}, {}, "from_surface needs patient.lumen_surface.sections: surface"),
+            ({"wall_array": "thickness"}, {}, "expected a point data array 'thickness'"),
+        ]
+        for surface_keys, _, message in bad:
+            sc = yaml.safe_load(yaml.safe_dump(scene))
+            sc["patient"]["lumen_surface"].update(surface_keys)
+            with self.assertRaisesRegex(PatientInputError, message):
+                prepare_scene(sc, scene_path, out, log=lambda m: None)
+        sc = yaml.safe_load(yaml.safe_dump(scene))
+        del sc["patient"]["lumen_surface"]
+        sc["patient"]["centerline"] = os.path.join(ROOT, "configs", "centerlines", "patient_like.csv")
+        with self.assertRaisesRegex(PatientInputError, "from_surface needs patient.lumen_surface"):
+            prepare_scene(sc, scene_path, out, log=lambda m: None)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
