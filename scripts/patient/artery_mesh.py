@@ -175,6 +175,18 @@ def _pie_loft(occ, reg, s, P, t, n1, radii, radius_of):
     return occ.addThruSections(wires, makeSolid=True, makeRuled=False)
 
 
+def section_at(sections, P, t, n1, n2, s, i):
+    """The section at loft station i; at an end station whose plane leaves the surface (a cut end not
+    normal to the centerline, the station within a hair of it), the next station's shape."""
+    try:
+        return sections.polar(P[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm")
+    except PatientInputError:
+        if i not in (0, len(P) - 1):
+            raise
+        j = 1 if i == 0 else len(P) - 2
+        return sections.polar(P[j], t[j], n1[j], n2[j], f"s = {s[j]:.2f} mm (for the end at {s[i]:.2f} mm)")
+
+
 def build_artery(
     points,
     radius,
@@ -201,9 +213,9 @@ def build_artery(
     if sections is not None:
         from .lumen_sections import low_pass
 
-        polar = [sections.polar(P[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(P))]
+        polar = [section_at(sections, P, t, n1, n2, s, i) for i in range(len(P))]
         r = low_pass([rho for rho, _ in polar])
-        w = low_pass([f for _, f in polar]) if sections.field is not None else np.repeat(w[:, None], r.shape[1], 1)
+        w = low_pass([f for _, f in polar]) if sections.wall_from else np.repeat(w[:, None], r.shape[1], 1)
     radii, ti, tm, ta = layer_radii(r, w, spec, where)
     gmsh.initialize()
     try:
@@ -298,6 +310,12 @@ def build_artery(
             )
         if not _min_quadratic_jacobian() > 0.0:
             raise RuntimeError("gmsh produced an inverted tetrahedron")
+        quality, where_bad = _min_scaled_jacobian()
+        if not quality > 0.0:  # positive at the samples but the corners' tetrahedron inverted: tangled
+            raise RuntimeError(
+                f"gmsh produced a tangled tet10 near ({', '.join(f'{x:.2f}' for x in where_bad)}) mm (its corner "
+                f"tetrahedron inverted, scaled Jacobian {quality:.3g}) {_size_hint(ti, tm, ta, mesh_size)}"
+            )
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
         gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
         gmsh.option.setNumber("Mesh.SaveAll", 0)
@@ -316,7 +334,7 @@ def build_artery(
             "per_layer": per_layer,
             "mesh_size": mesh_size,
             "straightened_tet10": int(straightened),
-            "min_scaled_jacobian": _min_scaled_jacobian(),
+            "min_scaled_jacobian": quality,
             "stations": int(len(P)),
             "sections": "circles" if r.ndim == 1 else f"lumen surface, {r.shape[1]} rays",
             "lumen_aspect_max": float(np.max(r.max(axis=1) / r.min(axis=1))) if r.ndim == 2 else 1.0,
@@ -332,16 +350,23 @@ def build_artery(
     except Exception as e:
         if type(e) is not Exception:  # a bug of ours, not gmsh's verdict on the geometry
             raise
-        # gmsh's Python API raises a bare Exception when it cannot build or mesh the geometry; the usual
-        # cause is a layer much thinner than the elements, whose two surface meshes then cross
-        thinnest = min((float(np.min(v)), name) for v, name in ((ti, "intima"), (tm, "media"), (ta, "adventitia")))
+        # gmsh's Python API raises a bare Exception when it cannot build or mesh the geometry
         raise PatientInputError(
-            f"{where}: gmsh cannot mesh the artery from this centerline: {' '.join(str(e).split())} (the "
-            f"thinnest layer, the {thinnest[1]}, is {thinnest[0]:.3f} mm against a mesh size of {mesh_size:g} mm: "
-            "a smaller patient.mesh.size or a thicker wall may mesh)"
+            f"{where}: gmsh cannot mesh the artery from this centerline: {' '.join(str(e).split())} "
+            f"{_size_hint(ti, tm, ta, mesh_size)}"
         ) from e
     finally:
         gmsh.finalize()
+
+
+def _size_hint(ti, tm, ta, mesh_size):
+    """What to change when gmsh fails: the usual cause is a layer much thinner than the elements, whose
+    surface meshes then cross or whose tetrahedra fold."""
+    t, name = min((float(np.min(v)), n) for v, n in ((ti, "intima"), (tm, "media"), (ta, "adventitia")))
+    return (
+        f"(the thinnest layer, the {name}, is {t:.3f} mm against a mesh size of {mesh_size:g} mm: a smaller "
+        "patient.mesh.size or a thicker wall may mesh)"
+    )
 
 
 def _min_quadratic_jacobian():
@@ -361,13 +386,13 @@ def _min_quadratic_jacobian():
 def _min_scaled_jacobian():
     """The smallest scaled Jacobian of the tet10: det J at the Gauss points and the ten nodes, over
     det J of the element's straight-sided tet4 (1 for a straight-sided tet10, <= 0 inverted or
-    folded; the measure gmsh's high-order optimizer works on). gmsh 4.8's own quality API has no
-    scaled Jacobian, so it is computed from getJacobians."""
+    folded; the measure gmsh's high-order optimizer works on), and the centroid of the worst element.
+    gmsh 4.8's own quality API has no scaled Jacobian, so it is computed from getJacobians."""
     import gmsh
 
     tags, nodes = gmsh.model.mesh.getElementsByType(11)
     if not len(tags):
-        return math.nan
+        return math.nan, np.zeros(3)
     gauss, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
     corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
     mids = np.array([0.5 * (corners[a] + corners[b]) for a, b in TET10_EDGES])
@@ -379,7 +404,9 @@ def _min_scaled_jacobian():
     ng = len(gauss) // 3
     c = xyz[:, ng : ng + 4]
     straight = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
-    return float(np.min(dets.min(axis=1) / straight))
+    q = dets.min(axis=1) / straight
+    k = int(np.argmin(q))
+    return float(q[k]), c[k].mean(axis=0)
 
 
 # gmsh tet10 mid-edge nodes 4..9 on the edges 01 12 20 30 32 31 (gmsh manual, "Node ordering")

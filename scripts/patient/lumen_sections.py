@@ -42,12 +42,19 @@ def _cross2(a, b):
 
 
 class LumenSections:
-    """Sections of one lumen surface; `field` an optional per-vertex array (e.g. the wall thickness)."""
+    """Sections of one lumen surface, with the wall thickness on the rays from `field` (a per-vertex
+    array of the surface), or from `outer` (the LumenSections of an outer-wall surface: the thickness
+    is then the distance between the two surfaces along each ray), or neither."""
 
-    def __init__(self, surface, field=None, field_name=None):
+    def __init__(self, surface, field=None, outer=None):
         self.surface = surface
         self.field = None if field is None else np.asarray(field, dtype=float)
-        self.field_name = field_name
+        self.outer = outer
+
+    @property
+    def wall_from(self):
+        """Where the wall thickness comes from: 'surface' (a point array), 'outer surface', or None."""
+        return "surface" if self.field is not None else "outer surface" if self.outer is not None else None
 
     def _cut(self, P, t):
         """The segments of the plane cut (2 points each, and the field at them) of the loop around P."""
@@ -123,18 +130,28 @@ class LumenSections:
             out_rho[k] = r[j]
             uk = min(max(u[k, seg_k], 0.0), 1.0)
             out_val[k] = val[seg_k, 0] + uk * (val[seg_k, 1] - val[seg_k, 0])
+        if self.outer is not None:
+            outer, _ = self.outer.polar(P, t, n1, n2, where, angles)
+            k = int(np.argmin(outer - out_rho))
+            if outer[k] <= out_rho[k]:
+                raise PatientInputError(
+                    f"{self.outer.surface.path}: the outer wall at {where} lies inside the lumen of "
+                    f"{self.surface.path} towards {np.degrees(theta[k]):.0f} degrees ({outer[k]:.3f} mm against "
+                    f"{out_rho[k]:.3f} mm from the centerline): expected an outer surface around the lumen"
+                )
+            return out_rho, outer - out_rho
         return out_rho, (out_val if self.field is not None else None)
 
-    def clearance_radius(self, P, t, n1, n2, where):
-        """The distance from P to the nearest point of its section (<= min rho): the radius of the
-        largest circle around P inside the lumen, what a device centered at P must clear."""
-        rho, _ = self.polar(P, t, n1, n2, where)
-        theta = 2.0 * np.pi * np.arange(len(rho)) / len(rho)
-        q = rho[:, None] * np.stack([np.cos(theta), np.sin(theta)], -1)
-        a, b = q, np.roll(q, -1, axis=0)
-        d = b - a
-        u = np.clip(-np.einsum("ij,ij->i", a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
-        return float(np.min(np.linalg.norm(a + u[:, None] * d, axis=1)))
+
+def inscribed_radius(rho):
+    """The distance from the rays' origin to the nearest point of the polygon through the polar
+    samples rho (<= min rho): the radius of the largest circle around the centerline point inside the
+    section, what a device centered there must clear."""
+    theta = 2.0 * np.pi * np.arange(len(rho)) / len(rho)
+    a = np.asarray(rho)[:, None] * np.stack([np.cos(theta), np.sin(theta)], -1)
+    d = np.roll(a, -1, axis=0) - a
+    u = np.clip(-np.einsum("ij,ij->i", a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(a + u[:, None] * d, axis=1)))
 
 
 def read_wall_field(surface_path, surface, name):

@@ -22,11 +22,11 @@ import numpy as np
 import insertion_tool
 import scene_keys
 
-from .artery_mesh import WallSpec, build_artery, layer_radii, rotation_minimizing_normals
+from .artery_mesh import WallSpec, build_artery, layer_radii, rotation_minimizing_normals, section_at
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
-from .lumen_sections import LumenSections, read_wall_field
+from .lumen_sections import LumenSections, inscribed_radius, read_wall_field
 from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 from .plaque import check_within_intima, plaque_materials, read_plaque
@@ -162,15 +162,24 @@ def lumen_csv(pat, scene_path, out_dir, log):
         out, points, radius, comment=f"lumen centerline of {path} (scripts/patient/lumen_centerline.py)"
     )
     log(f"patient: lumen surface {path.name}: {len(surface.triangles)} triangles -> {len(points)} centerline stations")
-    from_surface = (pat["wall"] or {}).get("thickness") == "from_surface"
+    thickness = (pat["wall"] or {}).get("thickness")
+    if thickness == "from_outer_surface" and not pat["outer_surface"]:
+        raise PatientInputError(
+            f"{scene_path}: patient.wall.thickness: from_outer_surface needs patient.outer_surface ({{file, units}})"
+        )
     if spec["sections"] == "circles":
-        if from_surface:
+        if thickness in ("from_surface", "from_outer_surface"):
             raise PatientInputError(
-                f"{scene_path}: patient.wall.thickness: from_surface needs patient.lumen_surface.sections: surface"
+                f"{scene_path}: patient.wall.thickness: {thickness} needs patient.lumen_surface.sections: surface"
             )
         return out, None
-    field = read_wall_field(str(path), surface, spec["wall_array"]) if from_surface else None
-    return out, LumenSections(surface, field, spec["wall_array"] if from_surface else None)
+    if thickness == "from_surface":
+        return out, LumenSections(surface, field=read_wall_field(str(path), surface, spec["wall_array"]))
+    if thickness == "from_outer_surface":
+        o = scene_keys.check_map(pat["outer_surface"], "patient.outer_surface", scene_path, PatientInputError)
+        outer = read_lumen_surface(str((scene_path.parent / o["file"]).resolve()), o["units"])
+        return out, LumenSections(surface, outer=LumenSections(outer))
+    return out, LumenSections(surface)
 
 
 def station_sections(cl, sections):
@@ -179,11 +188,10 @@ def station_sections(cl, sections):
     t, n1 = rotation_minimizing_normals(cl.points)
     n2 = np.cross(t, n1)
     s = cl.arc_length
-    polar = [sections.polar(cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
-    clear = [sections.clearance_radius(cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
+    polar = [section_at(sections, cl.points, t, n1, n2, s, i) for i in range(len(s))]
     rho = np.array([r for r, _ in polar])
-    field = np.array([f for _, f in polar]) if sections.field is not None else None
-    return rho, field, np.array(clear)
+    field = np.array([f for _, f in polar]) if sections.wall_from else None
+    return rho, field, np.array([inscribed_radius(r) for r in rho])
 
 
 def prepare_scene(scene, scene_path, out_dir, log=print):
@@ -206,10 +214,15 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
 
     csv_path, sections = lumen_csv(pat, scene_path, Path(out_dir), log)
     cl = read_centerline_csv(csv_path)
-    if wall["thickness"] == "from_surface" and not pat["lumen_surface"]:
+    if wall["thickness"] in ("from_surface", "from_outer_surface") and not pat["lumen_surface"]:
         raise PatientInputError(
-            f"{scene_path}: patient.wall.thickness: from_surface needs patient.lumen_surface (a surface with a "
-            "wall-thickness point array); with a centerline CSV use from_centerline or a number"
+            f"{scene_path}: patient.wall.thickness: {wall['thickness']} needs patient.lumen_surface (the wall is "
+            "read on the lumen surface's sections); with a centerline CSV use from_centerline or a number"
+        )
+    if pat["outer_surface"] and wall["thickness"] != "from_outer_surface":
+        raise PatientInputError(
+            f"{scene_path}: patient.outer_surface: expected patient.wall.thickness: from_outer_surface with it, got "
+            f"{wall['thickness']!r}"
         )
     if wall["thickness"] == "from_centerline":
         if pat["lumen_surface"]:
@@ -223,8 +236,8 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
                 f"has no `wall` column (or add the column)"
             )
         wall_t = cl.wall
-    elif wall["thickness"] == "from_surface":
-        wall_t = None  # from the surface's field, per ray (below)
+    elif wall["thickness"] in ("from_surface", "from_outer_surface"):
+        wall_t = None  # per ray, from the sections (below)
     else:
         wall_t = np.full(len(cl.radius), float(wall["thickness"]))
     # the lumen and wall per station as the mesh will have them: the true sections (n, K) when the
@@ -333,7 +346,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
                 "inscribed_diameter_range": [float(2 * cl_fit.radius.min()), float(2 * cl_fit.radius.max())],
                 "aspect_max": float(np.max(r_lumen.max(axis=1) / r_lumen.min(axis=1))),
                 "wall_range": [float(w_lumen.min()), float(w_lumen.max())],
-                "wall_from": "surface" if sections.field is not None else "patient.wall.thickness",
+                "wall_from": sections.wall_from or "patient.wall.thickness",
             }
         ),
         "placement": plc.report(),  # with sections, its lumen_diameter is the inscribed one (what the devices clear)

@@ -13,6 +13,8 @@ w = W0 + W1 cos(theta) (theta around the tube, 0 along +x: a wall thicker on one
 - the meshed three-layer wall (tet10): its volume and its intima's equal the polar integrals
   L/2 int (r_out^2 - r_in^2) dtheta of the radial offsets (media and adventitia thickness from the
   area-equivalent outer diameter, as artery_mesh.layer_radii) within 1 %, and no element is inverted;
+- the wall from an outer surface (a circle around the tube) is the distance between the surfaces
+  along each ray, within the chord errors; an outer surface cutting into the lumen is refused;
 - a thickness array the file does not have is refused naming it and the arrays it has.
 Usage: test_lumen_sections.py   (about 60 s)
 """
@@ -31,7 +33,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mesh_measures import tet10_volumes  # noqa: E402
 from patient.artery_mesh import WallSpec, build_artery  # noqa: E402
 from patient.errors import PatientInputError  # noqa: E402
-from patient.lumen_sections import LumenSections, read_wall_field  # noqa: E402
+from patient.lumen_sections import LumenSections, inscribed_radius, read_wall_field  # noqa: E402
 from patient.lumen_surface import read_lumen_surface  # noqa: E402
 
 A, B, E, LENGTH = 1.2, 0.8, 0.2, 6.0
@@ -86,7 +88,7 @@ class LumenSections_(unittest.TestCase):
 
     def test_clearance_radius_is_the_minor_semi_axis(self):
         t, n1, n2 = self.frame
-        r = self.sections.clearance_radius(np.array([E, 0.0, 3.0]), t, n1, n2, "z = 3")
+        r = inscribed_radius(self.sections.polar(np.array([E, 0.0, 3.0]), t, n1, n2, "z = 3")[0])
         self.assertLess(abs(r / B - 1), 1e-3)
         self.assertLess(r, ellipse_rho(np.linspace(0, 2 * np.pi, 97)).min() + 1e-9)
 
@@ -104,6 +106,27 @@ class LumenSections_(unittest.TestCase):
         t, n1, n2 = self.frame
         with self.assertRaisesRegex(PatientInputError, r"c\.stl: the section at z = 3 .*not star-shaped"):
             sections.polar(np.array([-0.2, 0.0, 3.0]), t, n1, n2, "z = 3")
+
+    def test_wall_from_an_outer_surface(self):
+        """The thickness along each ray is the distance from the ellipse to a circular outer wall of radius
+        RO around the z axis (the rays start at (E, 0)): t(theta) = -E cos + sqrt(RO^2 - E^2 sin^2) - rho;
+        within the two 96-gons' chord errors. An outer surface cutting into the lumen is refused."""
+        t, n1, n2 = self.frame
+        paths = {}
+        for name, radius in (("outer", 2.2), ("inner", 1.1)):
+            pts, tris, _ = ellipse_tube(lambda phi, r=radius: (r * np.cos(phi), r * np.sin(phi)))
+            paths[name] = os.path.join(self.tmp, f"{name}.stl")
+            meshio.write(paths[name], meshio.Mesh(pts, [("triangle", tris)]))
+        outer = LumenSections(read_lumen_surface(paths["outer"]))
+        sections = LumenSections(self.surface, outer=outer)
+        rho, w = sections.polar(np.array([E, 0.0, 3.0]), t, n1, n2, "z = 3")
+        theta = 2 * np.pi * np.arange(len(rho)) / len(rho)
+        exact = -E * np.cos(theta) + np.sqrt(2.2**2 - (E * np.sin(theta)) ** 2) - ellipse_rho(theta)
+        self.assertLess(np.max(np.abs(w - exact)), 3e-3)
+        self.assertEqual(sections.wall_from, "outer surface")
+        inside = LumenSections(self.surface, outer=LumenSections(read_lumen_surface(paths["inner"])))
+        with self.assertRaisesRegex(PatientInputError, r"inner\.stl: the outer wall at z = 3 lies inside the lumen"):
+            inside.polar(np.array([E, 0.0, 3.0]), t, n1, n2, "z = 3")
 
     def test_missing_thickness_array_is_refused(self):
         with self.assertRaisesRegex(
@@ -184,6 +207,14 @@ class LumenSections_(unittest.TestCase):
             sc["patient"]["lumen_surface"].update(surface_keys)
             with self.assertRaisesRegex(PatientInputError, message):
                 prepare_scene(sc, scene_path, out, log=lambda m: None)
+        sc = yaml.safe_load(yaml.safe_dump(scene))
+        sc["patient"]["wall"]["thickness"] = "from_outer_surface"
+        with self.assertRaisesRegex(PatientInputError, "from_outer_surface needs patient.outer_surface"):
+            prepare_scene(sc, scene_path, out, log=lambda m: None)
+        sc["patient"]["wall"]["thickness"] = 0.6
+        sc["patient"]["outer_surface"] = {"file": self.path}
+        with self.assertRaisesRegex(PatientInputError, "patient.outer_surface: expected patient.wall.thickness"):
+            prepare_scene(sc, scene_path, out, log=lambda m: None)
         sc = yaml.safe_load(yaml.safe_dump(scene))
         del sc["patient"]["lumen_surface"]
         sc["patient"]["centerline"] = os.path.join(ROOT, "configs", "centerlines", "patient_like.csv")

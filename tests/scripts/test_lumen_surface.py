@@ -142,7 +142,9 @@ class LumenSurface(unittest.TestCase):
         surface = self.write(*tube(), "vessel.stl")
         with open(os.path.join(ROOT, "configs", "patient_like.yaml")) as f:
             scene = yaml.safe_load(f)
-        scene["patient"]["lumen_surface"] = {"file": surface}
+        # circles: this test is about the centerline (the surface's own sections are scripts.lumen_sections'),
+        # and its coarse mesh (1 mm against a 0.075 mm intima) meshes with circles only
+        scene["patient"]["lumen_surface"] = {"file": surface, "sections": "circles"}
         del scene["patient"]["centerline"]
         scene["patient"]["wall"]["thickness"] = 0.6
         scene["patient"]["mesh"]["size"] = 1.0  # coarse: this test is about the lumen
