@@ -57,42 +57,44 @@ class LumenSections:
         return "surface" if self.field is not None else "outer surface" if self.outer is not None else None
 
     def _cut(self, P, t):
-        """The segments of the plane cut (2 points each, and the field at them) of the loop around P."""
+        """The segments of the plane cut of the surface: their end points (m, 2, 3), the mesh edges
+        they lie on (m, 2, 2 vertex ids) with the position along each edge (m, 2), and their loop."""
         X, T = self.surface.points, self.surface.triangles
         d = (X - P) @ t
         above = d[T] > 0.0
         cut = np.flatnonzero(above.any(axis=1) & ~above.all(axis=1))
         if not len(cut):
             return None
-        ends, keys, vals = [], [], []
+        ends, keys, edges, us = [], [], [], []
         for k in range(3):
             a, b = T[cut, k], T[cut, (k + 1) % 3]
             cross = above[cut, k] != above[cut, (k + 1) % 3]
             u = np.where(cross, d[a] / np.where(cross, d[a] - d[b], 1.0), 0.0)
             ends.append(np.where(cross[:, None], X[a] + u[:, None] * (X[b] - X[a]), np.nan))
             keys.append(np.where(cross, np.minimum(a, b) * len(X) + np.maximum(a, b), -1))
-            f = self.field if self.field is not None else np.zeros(len(X))
-            vals.append(f[a] + u * (f[b] - f[a]))
-        ends, keys, vals = np.stack(ends, 1), np.stack(keys, 1), np.stack(vals, 1)
+            edges.append(np.stack([a, b], -1))
+            us.append(u)
+        ends, keys, edges, us = np.stack(ends, 1), np.stack(keys, 1), np.stack(edges, 1), np.stack(us, 1)
         # each cut triangle crosses the plane on exactly two of its edges
         order = np.argsort(keys < 0, axis=1, kind="stable")[:, :2]
         rows = np.arange(len(cut))[:, None]
-        seg, key, val = ends[rows, order], keys[rows, order], vals[rows, order]
+        seg, key, edge, eu = ends[rows, order], keys[rows, order], edges[rows, order], us[rows, order]
         # loops: connected components of the segments through the mesh edges they cross
         uniq, inv = np.unique(key, return_inverse=True)
         inv = inv.reshape(-1, 2)
         graph = scipy.sparse.coo_matrix((np.ones(len(inv)), (inv[:, 0], inv[:, 1])), shape=(len(uniq),) * 2)
         _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
-        return seg, val, label[inv[:, 0]]
+        return seg, edge, eu, label[inv[:, 0]]
 
-    def polar(self, P, t, n1, n2, where, angles=ANGLES):
-        """(rho, field) at `angles` rays from P in the plane through P normal to t, theta from n1 towards
-        n2; PatientInputError (naming `where`) when the plane misses the lumen around P or a ray leaves
-        it more than once."""
+    def _rays(self, P, t, n1, n2, where, angles):
+        """Where `angles` rays from P in the plane through P normal to t (theta from n1 towards n2) meet
+        the lumen: (rho (K,), the mesh edges of the hit segment's ends (K, 2, 2), their positions on
+        them (K, 2), the position along the segment (K,)); PatientInputError (naming `where`) when the
+        plane misses the lumen around P or a ray leaves it more than once."""
         got = self._cut(P, t)
         if got is None:
             raise PatientInputError(f"{self.surface.path}: the section at {where} does not cut the lumen surface")
-        seg, val, loop = got
+        seg, edge, eu, loop = got
         a = np.stack([(seg[:, 0] - P) @ n1, (seg[:, 0] - P) @ n2], -1)
         b = np.stack([(seg[:, 1] - P) @ n1, (seg[:, 1] - P) @ n2], -1)
         theta = 2.0 * np.pi * np.arange(angles) / angles
@@ -108,7 +110,7 @@ class LumenSections:
         if not own.any():
             raise PatientInputError(f"{self.surface.path}: the section at {where} does not enclose the centerline")
         hit &= (loop == int(np.argmax(own)))[None]
-        out_rho, out_val = np.empty(angles), np.empty(angles)
+        out_rho, out_seg, out_u = np.empty(angles), np.empty(angles, dtype=int), np.empty(angles)
         for k in range(angles):
             r = rho[k, hit[k]]
             if not len(r):
@@ -126,21 +128,36 @@ class LumenSections:
                     "fold of the surface; smooth it or cut the vessel shorter)"
                 )
             j = int(np.argmin(r))
-            seg_k = np.flatnonzero(hit[k])[j]
+            out_seg[k] = np.flatnonzero(hit[k])[j]
             out_rho[k] = r[j]
-            uk = min(max(u[k, seg_k], 0.0), 1.0)
-            out_val[k] = val[seg_k, 0] + uk * (val[seg_k, 1] - val[seg_k, 0])
+            out_u[k] = min(max(u[k, out_seg[k]], 0.0), 1.0)
+        return out_rho, edge[out_seg], eu[out_seg], out_u
+
+    def polar(self, P, t, n1, n2, where, angles=ANGLES):
+        """(rho, wall thickness or None) on `angles` rays from P (see _rays)."""
+        rho, edge, eu, u = self._rays(P, t, n1, n2, where, angles)
         if self.outer is not None:
             outer, _ = self.outer.polar(P, t, n1, n2, where, angles)
-            k = int(np.argmin(outer - out_rho))
-            if outer[k] <= out_rho[k]:
+            k = int(np.argmin(outer - rho))
+            if outer[k] <= rho[k]:
                 raise PatientInputError(
                     f"{self.outer.surface.path}: the outer wall at {where} lies inside the lumen of "
-                    f"{self.surface.path} towards {np.degrees(theta[k]):.0f} degrees ({outer[k]:.3f} mm against "
-                    f"{out_rho[k]:.3f} mm from the centerline): expected an outer surface around the lumen"
+                    f"{self.surface.path} towards {360.0 * k / angles:.0f} degrees ({outer[k]:.3f} mm against "
+                    f"{rho[k]:.3f} mm from the centerline): expected an outer surface around the lumen"
                 )
-            return out_rho, outer - out_rho
-        return out_rho, (out_val if self.field is not None else None)
+            return rho, outer - rho
+        if self.field is None:
+            return rho, None
+        f = self.field[edge]  # (K, 2 segment ends, 2 edge vertices)
+        ends = f[..., 0] + eu * (f[..., 1] - f[..., 0])
+        return rho, ends[:, 0] + u * (ends[:, 1] - ends[:, 0])
+
+    def labels(self, values, P, t, n1, n2, where, angles=ANGLES):
+        """A per-vertex label array on the rays: the label of the surface vertex nearest each hit."""
+        _, edge, eu, u = self._rays(P, t, n1, n2, where, angles)
+        end = np.where(u < 0.5, 0, 1)
+        rows = np.arange(len(u))
+        return np.asarray(values)[edge[rows, end, np.where(eu[rows, end] < 0.5, 0, 1)]]
 
 
 def inscribed_radius(rho):
@@ -154,24 +171,33 @@ def inscribed_radius(rho):
     return float(np.min(np.linalg.norm(a + u[:, None] * d, axis=1)))
 
 
-def read_wall_field(surface_path, surface, name):
-    """The point-data array `name` of the surface file, on the merged vertices of `surface` (mm)."""
+def point_array(surface_path, surface, name, what):
+    """The point-data array `name` of the surface file (`what` it holds, for messages), on the merged
+    vertices of `surface`: one finite value per vertex."""
     import meshio
 
     mesh = meshio.read(surface_path)
     if name not in mesh.point_data:
         have = ", ".join(sorted(mesh.point_data)) or "none"
         raise PatientInputError(
-            f"{surface_path}: expected a point data array '{name}' (the wall thickness, mm), got arrays: {have} "
+            f"{surface_path}: expected a point data array '{name}' ({what}), got arrays: {have} "
             "(STL carries none: write VTK, VTU or PLY)"
         )
     values = np.asarray(mesh.point_data[name], dtype=float)
-    if values.ndim != 1:
-        raise PatientInputError(f"{surface_path}: point data '{name}': expected one value per vertex")
-    if not np.all(np.isfinite(values)) or values.min() <= 0.0:
-        raise PatientInputError(f"{surface_path}: point data '{name}': expected positive finite thicknesses (mm)")
+    if values.ndim == 2 and values.shape[1] == 1:
+        values = values[:, 0]
+    if values.ndim != 1 or not np.all(np.isfinite(values)):
+        raise PatientInputError(f"{surface_path}: point data '{name}': expected one finite value per vertex")
     # the surface's merged vertices came from these points: each keeps the value of its nearest original
     from scipy.spatial import cKDTree
 
     _, idx = cKDTree(np.asarray(mesh.points, dtype=float)[:, :3] * surface.scale).query(surface.points)
-    return values[idx] * surface.scale
+    return values[idx]
+
+
+def read_wall_field(surface_path, surface, name):
+    """The wall thickness array `name` of the surface file, on the merged vertices of `surface` (mm)."""
+    values = point_array(surface_path, surface, name, "the wall thickness, mm")
+    if values.min() <= 0.0:
+        raise PatientInputError(f"{surface_path}: point data '{name}': expected positive thicknesses (mm)")
+    return values * surface.scale

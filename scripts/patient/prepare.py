@@ -30,6 +30,7 @@ from .lumen_sections import LumenSections, inscribed_radius, read_wall_field
 from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 from .plaque import check_within_intima, plaque_materials, read_plaque
+from .plaque_labels import read_labels, regions_from_labels
 
 # The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
 # and checked by scene_keys.check_map.
@@ -194,6 +195,27 @@ def station_sections(cl, sections):
     return rho, field, np.array([inscribed_radius(r) for r in rho])
 
 
+def plaque_from_surface(pat, cl, sections, scene_path):
+    """The patient.plaque entries of patient.lumen_surface.plaque (plaque_labels.py), or []."""
+    surf = pat["lumen_surface"] or {}
+    if not surf.get("plaque"):
+        return []
+    key = "patient.lumen_surface.plaque"
+    spec = scene_keys.check_map(surf["plaque"], key, scene_path, PatientInputError)
+    if sections is None:
+        raise PatientInputError(f"{scene_path}: {key}: needs patient.lumen_surface.sections: surface")
+    if not spec["types"] or not all(isinstance(x, str) for x in spec["types"]):
+        raise PatientInputError(
+            f"{scene_path}: {key}.types: expected a list of plaque type names, got {spec['types']!r}"
+        )
+    labels = read_labels(sections.surface.path, sections.surface, spec["array"])
+    t, n1 = rotation_minimizing_normals(cl.points)
+    n2 = np.cross(t, n1)
+    s = cl.arc_length
+    grid = [sections.labels(labels, cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
+    return regions_from_labels(np.array(grid), s, spec["types"], spec["thickness"], f"{scene_path}: {key}")
+
+
 def prepare_scene(scene, scene_path, out_dir, log=print):
     """The completed scene (a new dict) with its generated files in out_dir; PatientInputError on bad input."""
     scene_path = Path(scene_path)
@@ -261,7 +283,10 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     spec = WallSpec(
         media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"], min_intima=wall["min_intima"]
     )
-    plaque = read_plaque(pat["plaque"], float(cl.arc_length[-1]), scene_path)
+    from_labels = plaque_from_surface(pat, cl, sections, scene_path)
+    if from_labels:
+        log(f"patient: {len(from_labels)} plaque regions from the surface's labels")
+    plaque = read_plaque((pat["plaque"] or []) + from_labels, float(cl.arc_length[-1]), scene_path)
     if plaque:
         check_within_intima(plaque, cl.arc_length, layer_radii(r_lumen, w_lumen, spec, str(csv_path))[1], scene_path)
     layers = artery.get("layers")

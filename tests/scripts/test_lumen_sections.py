@@ -15,6 +15,9 @@ w = W0 + W1 cos(theta) (theta around the tube, 0 along +x: a wall thicker on one
   area-equivalent outer diameter, as artery_mesh.layer_radii) within 1 %, and no element is inverted;
 - the wall from an outer surface (a circle around the tube) is the distance between the surfaces
   along each ray, within the chord errors; an outer surface cutting into the lumen is refused;
+- plaque from a label array: the sectors bound the labelled patches within a ray and a facet spacing
+  (angles) and a station and a ring spacing (arc length), a patch across angle 0 is one sector, and
+  the regions are meshed as plaque layers by the pipeline;
 - a thickness array the file does not have is refused naming it and the arrays it has.
 Usage: test_lumen_sections.py   (about 60 s)
 """
@@ -35,6 +38,7 @@ from patient.artery_mesh import WallSpec, build_artery  # noqa: E402
 from patient.errors import PatientInputError  # noqa: E402
 from patient.lumen_sections import LumenSections, inscribed_radius, read_wall_field  # noqa: E402
 from patient.lumen_surface import read_lumen_surface  # noqa: E402
+from patient.plaque_labels import read_labels, regions_from_labels  # noqa: E402
 
 A, B, E, LENGTH = 1.2, 0.8, 0.2, 6.0
 W0, W1 = 1.0, 0.3
@@ -57,6 +61,16 @@ def ellipse_tube(section=None):
     return pts, np.array(tris), W0 + W1 * np.cos(theta)
 
 
+def plaque_labels(pts):
+    """1 (calcified) over 30..90 deg and z 2..4 mm, 2 (lipid) over 200..260 deg and z 2.5..3.5 mm."""
+    deg = np.mod(np.degrees(np.arctan2(pts[:, 1], pts[:, 0] - E)), 360.0)
+    z = pts[:, 2]
+    lab = np.zeros(len(pts), dtype=np.int32)
+    lab[(deg >= 30) & (deg <= 90) & (z >= 2) & (z <= 4)] = 1
+    lab[(deg >= 200) & (deg <= 260) & (z >= 2.5) & (z <= 3.5)] = 2
+    return lab
+
+
 def ellipse_rho(theta):
     """Polar radius of the ellipse around its center."""
     return A * B / np.sqrt((B * np.cos(theta)) ** 2 + (A * np.sin(theta)) ** 2)
@@ -68,7 +82,8 @@ class LumenSections_(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="angio-sections-")
         pts, tris, w = ellipse_tube()
         cls.path = os.path.join(cls.tmp, "ellipse.vtk")
-        meshio.write(cls.path, meshio.Mesh(pts, [("triangle", tris)], point_data={"wall_thickness": w}))
+        data = {"wall_thickness": w, "plaque": plaque_labels(pts)}
+        meshio.write(cls.path, meshio.Mesh(pts, [("triangle", tris)], point_data=data))
         cls.surface = read_lumen_surface(cls.path)
         cls.sections = LumenSections(cls.surface, read_wall_field(cls.path, cls.surface, "wall_thickness"))
         cls.frame = (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
@@ -128,6 +143,31 @@ class LumenSections_(unittest.TestCase):
         with self.assertRaisesRegex(PatientInputError, r"inner\.stl: the outer wall at z = 3 lies inside the lumen"):
             inside.polar(np.array([E, 0.0, 3.0]), t, n1, n2, "z = 3")
 
+    def test_plaque_sectors_from_labels(self):
+        """Sectors that bound each label patch: within half a ray (3.75 deg) plus the facets' spacing
+        (3.75 deg) of the labelled angles, within half a station plus the rings' spacing (0.2 mm) of the
+        labelled z; a patch across angle 0 is one sector through 0; too many labels are refused."""
+        t, n1, n2 = self.frame
+        labels = read_labels(self.path, self.surface, "plaque")
+        z = np.linspace(0.1, LENGTH - 0.1, 59)
+        grid = [self.sections.labels(labels, np.array([E, 0.0, zi]), t, n1, n2, f"z = {zi}") for zi in z]
+        got = regions_from_labels(np.array(grid), z - z[0], ["calcified", "lipid"], 0.3, "test")
+        self.assertEqual([e["type"] for e in got], ["calcified", "lipid"])
+        for e, (a0, a1, z0, z1) in zip(got, ((30, 90, 2.0, 4.0), (200, 260, 2.5, 3.5))):
+            self.assertLess(abs(e["angle"][0] - a0), 7.5, e)
+            self.assertLess(abs(e["angle"][1] - a1), 7.5, e)
+            self.assertLess(abs(e["from_s"] + z[0] - z0), 0.25, e)
+            self.assertLess(abs(e["to_s"] + z[0] - z1), 0.25, e)
+            self.assertEqual(e["thickness"], 0.3)
+        across = np.zeros((5, 48), dtype=int)
+        across[1:4, [46, 47, 0, 1]] = 1
+        (e,) = regions_from_labels(across, np.arange(5.0), ["fibrous"], None, "test")
+        self.assertEqual(e["angle"], [-18.75, 11.25])  # rays at 345, 352.5, 0, 7.5 deg
+        self.assertEqual((e["from_s"], e["to_s"]), (0.5, 3.5))
+        self.assertNotIn("thickness", e)
+        with self.assertRaisesRegex(PatientInputError, "test.types: expected a name for every label"):
+            regions_from_labels(2 * across, np.arange(5.0), ["fibrous"], None, "test")
+
     def test_missing_thickness_array_is_refused(self):
         with self.assertRaisesRegex(
             PatientInputError, r"ellipse\.vtk: expected a point data array 'wall'.*wall_thickness"
@@ -183,6 +223,7 @@ class LumenSections_(unittest.TestCase):
         scene["patient"]["lumen_surface"] = {"file": self.path}
         scene["patient"]["wall"]["thickness"] = "from_surface"
         scene["patient"]["stenosis"] = 3.0  # a uniform tube: its middle
+        scene["patient"]["lumen_surface"]["plaque"] = {"array": "plaque", "types": ["calcified", "lipid"]}
         scene["patient"]["mesh"]["size"] = 0.8
         scene["balloon"]["mesh"].update(length=5.0, n_axial=34)
         scene["stent"]["generator"].update(rings=2, ring_pitch=1.5)
@@ -198,6 +239,8 @@ class LumenSections_(unittest.TestCase):
         self.assertEqual(sec["wall_from"], "surface")
         self.assertAlmostEqual(report["placement"]["clearance"]["balloon"], B - 0.49, delta=0.01)
         self.assertGreater(report["artery_mesh"]["min_scaled_jacobian"], 0.0)
+        self.assertEqual([p["layer"] for p in report["plaque"]], ["plaque_calcified", "plaque_lipid"])
+        self.assertGreater(report["artery_mesh"]["per_layer"]["plaque_lipid"], 0)
         bad = [
             ({"sections": "circles"}, {}, "from_surface needs patient.lumen_surface.sections: surface"),
             ({"wall_array": "thickness"}, {}, "expected a point data array 'thickness'"),
