@@ -143,25 +143,36 @@ def add_insertion(done, plc, dev, ins, scene_path):
 
 
 def lumen_csv(pat, scene_path, out_dir, log):
-    """(CSV, sections) of the scene: patient.centerline as given, or the one computed from
-    patient.lumen_surface into out_dir/lumen_from_surface.csv with the surface's true sections
+    """(CSV, sections) of the scene: patient.centerline as given; or, with patient.lumen_surface, a CSV
+    in out_dir/lumen_from_surface.csv (the centerline computed from the surface, or the given one,
+    with the area-equivalent radius of the surface's sections) and the surface's true sections
     (lumen_sections.LumenSections, None for circles)."""
-    given = [k for k in ("centerline", "lumen_surface") if pat[k]]
-    if len(given) != 1:
+    if not pat["centerline"] and not pat["lumen_surface"]:
         raise PatientInputError(
-            f"{scene_path}: patient: expected exactly one of centerline (a CSV) and lumen_surface "
-            f"({{file, units}}), got {' and '.join(given) or 'neither'}"
+            f"{scene_path}: patient: expected centerline (a CSV), lumen_surface ({{file, units}}), or both (the "
+            "CSV's centerline through the surface's sections), got neither"
         )
-    if pat["centerline"]:
+    if not pat["lumen_surface"]:
         return (scene_path.parent / pat["centerline"]).resolve(), None
     spec = scene_keys.check_map(pat["lumen_surface"], "patient.lumen_surface", scene_path, PatientInputError)
     path = (scene_path.parent / spec["file"]).resolve()
     surface = read_lumen_surface(str(path), spec["units"])
-    points, radius = lumen_centerline(surface, spacing=spec["spacing"])
     out = out_dir / "lumen_from_surface.csv"
-    write_centerline_csv(
-        out, points, radius, comment=f"lumen centerline of {path} (scripts/patient/lumen_centerline.py)"
-    )
+    if pat["centerline"]:  # the given centerline; its radius from the surface (sqrt(A / pi) of each section)
+        csv = (scene_path.parent / pat["centerline"]).resolve()
+        given = read_centerline_csv(csv)
+        points, wall = given.points, given.wall
+        t, n1 = rotation_minimizing_normals(points)
+        n2 = np.cross(t, n1)
+        s = given.arc_length
+        plain = LumenSections(surface)
+        rho = [section_at(plain, points, t, n1, n2, s, i)[0] for i in range(len(s))]
+        radius = np.sqrt(np.mean(np.square(rho), axis=1))
+        comment = f"centerline of {csv} with the equivalent radius of the sections of {path}"
+    else:
+        points, radius = lumen_centerline(surface, spacing=spec["spacing"])
+        wall, comment = None, f"lumen centerline of {path} (scripts/patient/lumen_centerline.py)"
+    write_centerline_csv(out, points, radius, wall=wall, comment=comment)
     log(f"patient: lumen surface {path.name}: {len(surface.triangles)} triangles -> {len(points)} centerline stations")
     thickness = (pat["wall"] or {}).get("thickness")
     if thickness == "from_outer_surface" and not pat["outer_surface"]:
@@ -247,10 +258,10 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
             f"{wall['thickness']!r}"
         )
     if wall["thickness"] == "from_centerline":
-        if pat["lumen_surface"]:
+        if pat["lumen_surface"] and not pat["centerline"]:
             raise PatientInputError(
-                f"{scene_path}: patient.wall.thickness: expected a number (mm) with patient.lumen_surface "
-                "(a lumen surface carries no wall thickness)"
+                f"{scene_path}: patient.wall.thickness: expected a number (mm), from_surface or from_outer_surface "
+                "with patient.lumen_surface and no centerline CSV"
             )
         if cl.wall is None:
             raise PatientInputError(

@@ -168,6 +168,28 @@ class LumenSections_(unittest.TestCase):
         with self.assertRaisesRegex(PatientInputError, "test.types: expected a name for every label"):
             regions_from_labels(2 * across, np.arange(5.0), ["fibrous"], None, "test")
 
+    def test_a_given_centerline_through_the_surface(self):
+        """patient.centerline and patient.lumen_surface together: the CSV's points, the radius of the
+        surface's sections (an ellipse around its center: sqrt(A B)), the CSV's wall column kept."""
+        from pathlib import Path
+
+        from patient.centerline_csv import read_centerline_csv, write_centerline_csv
+        from patient.prepare import lumen_csv
+
+        z = np.linspace(0.1, LENGTH - 0.1, 30)
+        pts = np.column_stack([np.full_like(z, E), np.zeros_like(z), z])
+        given = os.path.join(self.tmp, "given.csv")
+        write_centerline_csv(given, pts, np.ones_like(z), wall=np.full_like(z, 0.7))
+        pat = {"centerline": given, "lumen_surface": {"file": self.path}, "wall": {"thickness": "from_centerline"}}
+        out = Path(self.tmp) / "given"
+        out.mkdir(exist_ok=True)
+        csv, sections = lumen_csv(dict(pat, outer_surface=None), Path(self.tmp) / "scene.yaml", out, lambda m: None)
+        cl = read_centerline_csv(csv)
+        self.assertLess(np.abs(cl.points - pts).max(), 1e-6)
+        self.assertLess(np.abs(cl.radius / np.sqrt(A * B) - 1).max(), 2e-3)
+        self.assertTrue(np.allclose(cl.wall, 0.7))
+        self.assertIsNotNone(sections)
+
     def test_missing_thickness_array_is_refused(self):
         with self.assertRaisesRegex(
             PatientInputError, r"ellipse\.vtk: expected a point data array 'wall'.*wall_thickness"

@@ -159,10 +159,10 @@ class LumenSurface(unittest.TestCase):
         self.assertAlmostEqual(min(report["lumen_diameter_range"]), 1.8, delta=0.02)  # 40 % of 3 mm
         # gmsh's minimal scaled Jacobian of the written mesh: positive (no inverted element), at most 1
         self.assertTrue(0.0 < report["artery_mesh"]["min_scaled_jacobian"] <= 1.0, report["artery_mesh"])
-        # both keys, or a thickness from a column the surface does not have: refused naming the key
-        both = dict(scene, patient=dict(scene["patient"], centerline="x.csv"))
-        with self.assertRaisesRegex(PatientInputError, "exactly one of centerline"):
-            prepare_scene(both, scene_path, out, log=lambda m: None)
+        # neither key, or a thickness from a column the surface does not have: refused naming the key
+        neither = dict(scene, patient={k: v for k, v in scene["patient"].items() if k != "lumen_surface"})
+        with self.assertRaisesRegex(PatientInputError, "expected centerline .* got neither"):
+            prepare_scene(neither, scene_path, out, log=lambda m: None)
         col = dict(scene, patient=dict(scene["patient"], wall={"thickness": "from_centerline"}))
         with self.assertRaisesRegex(PatientInputError, "patient.wall.thickness"):
             prepare_scene(col, scene_path, out, log=lambda m: None)
