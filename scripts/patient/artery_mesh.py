@@ -53,6 +53,13 @@ def rotation_minimizing_normals(pts):
     return t, n
 
 
+def section_frames(points):
+    """(t, n1, n2) per station: the tangent and the rotation-minimizing frame of the sections, angle 0
+    along n1 (plaque angles, the lumen sections' rays)."""
+    t, n1 = rotation_minimizing_normals(points)
+    return t, n1, np.cross(t, n1)
+
+
 def resample(points, values, spacing):
     """Stations at (about) equal arc-length spacing, values interpolated linearly."""
     s = arc_length(points)
@@ -208,8 +215,7 @@ def build_artery(
     import gmsh
 
     s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
-    t, n1 = rotation_minimizing_normals(P)
-    n2 = np.cross(t, n1)
+    t, n1, n2 = section_frames(P)
     if sections is not None:
         from .lumen_sections import low_pass
 

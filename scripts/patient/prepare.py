@@ -22,7 +22,7 @@ import numpy as np
 import insertion_tool
 import scene_keys
 
-from .artery_mesh import WallSpec, build_artery, layer_radii, rotation_minimizing_normals, section_at
+from .artery_mesh import WallSpec, build_artery, layer_radii, section_at, section_frames
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
@@ -162,8 +162,7 @@ def lumen_csv(pat, scene_path, out_dir, log):
         csv = (scene_path.parent / pat["centerline"]).resolve()
         given = read_centerline_csv(csv)
         points, wall = given.points, given.wall
-        t, n1 = rotation_minimizing_normals(points)
-        n2 = np.cross(t, n1)
+        t, n1, n2 = section_frames(points)
         s = given.arc_length
         plain = LumenSections(surface)
         rho = [section_at(plain, points, t, n1, n2, s, i)[0] for i in range(len(s))]
@@ -197,8 +196,7 @@ def lumen_csv(pat, scene_path, out_dir, log):
 def station_sections(cl, sections):
     """Per centerline station of cl: the sections' polar lumen radius and wall field (n, K) (the
     field None without one) and the clearance radius (n,), in the loft's frames."""
-    t, n1 = rotation_minimizing_normals(cl.points)
-    n2 = np.cross(t, n1)
+    t, n1, n2 = section_frames(cl.points)
     s = cl.arc_length
     polar = [section_at(sections, cl.points, t, n1, n2, s, i) for i in range(len(s))]
     rho = np.array([r for r, _ in polar])
@@ -220,8 +218,7 @@ def plaque_from_surface(pat, cl, sections, scene_path):
             f"{scene_path}: {key}.types: expected a list of plaque type names, got {spec['types']!r}"
         )
     labels = read_labels(sections.surface.path, sections.surface, spec["array"])
-    t, n1 = rotation_minimizing_normals(cl.points)
-    n2 = np.cross(t, n1)
+    t, n1, n2 = section_frames(cl.points)
     s = cl.arc_length
     grid = [sections.labels(labels, cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
     return regions_from_labels(np.array(grid), s, spec["types"], spec["thickness"], f"{scene_path}: {key}")
