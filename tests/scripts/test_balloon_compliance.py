@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Compliance of the balloons of configs/procedure_stenosis.yaml (solid alone, free balloon).
+"""Compliance of the post-dilatation balloon of configs/procedure_stenosis.yaml (solid alone, free balloon).
 
 The post-dilatation balloon is declared non-compliant: 2.5 mm nominal at 12 atm and growing well
 below 1 %/atm above it. Against that declaration (its calibration targets, in the scene's comment):
