@@ -15,6 +15,7 @@ from the in-plane normal towards the bend's center (patient pipeline: 0 deg), +y
 calcified arc there is `angle: [60, 120]`.
 
   scripts/make_lesion_surface.py configs/lesions/eccentric_lesion.vtk [--stl lumen.stl]
+  scripts/make_lesion_surface.py configs/lesions/elliptic_aspect2.vtk --aspect 2 --narrowing 0.3 --shift 0
 
 VTK (legacy, binary) keeps the `wall_thickness` array; STL keeps the surface only. Units: mm."""
 import argparse
@@ -34,7 +35,7 @@ def lesion(s):
     return np.exp(-(((s - SITE) / WIDTH) ** 2))
 
 
-def surface():
+def surface(narrowing=NARROWING, aspect=ASPECT, shift=SHIFT):
     """(points (n, 3), triangles (m, 3), wall thickness per point (n,))."""
     s = np.linspace(0.0, LENGTH, int(round(LENGTH / DS)) + 1)
     phi = s / ARC_RADIUS
@@ -43,10 +44,10 @@ def surface():
     n2 = np.array([0.0, 1.0, 0.0])
     theta = 2 * np.pi * np.arange(AROUND) / AROUND
     g = lesion(s)[:, None]
-    r_eq = R_REF * (1 - NARROWING * g)
-    k = 1 + (np.sqrt(ASPECT) - 1) * g  # semi-axes r_eq k and r_eq / k: the area of the equivalent circle
+    r_eq = R_REF * (1 - narrowing * g)
+    k = 1 + (np.sqrt(aspect) - 1) * g  # semi-axes r_eq k and r_eq / k: the area of the equivalent circle
     x = r_eq * k * np.cos(theta)
-    y = r_eq / k * np.sin(theta) - SHIFT * g
+    y = r_eq / k * np.sin(theta) - shift * g
     pts = center[:, None, :] + x[..., None] * n1[:, None, :] + y[..., None] * n2
     wall = WALL + PLAQUE * g * np.clip(np.sin(theta), 0.0, None) ** 2
     n = len(s)
@@ -60,8 +61,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", help="the surface with its wall_thickness array (.vtk, .vtu, .ply)")
     ap.add_argument("--stl", help="also the surface alone as STL")
+    ap.add_argument("--narrowing", type=float, default=NARROWING, help="diameter stenosis of the equivalent lumen")
+    ap.add_argument("--aspect", type=float, default=ASPECT, help="the ellipse's aspect ratio at the throat")
+    ap.add_argument("--shift", type=float, default=SHIFT, help="mm the lumen moves away from the plaque")
     a = ap.parse_args()
-    pts, tris, wall = surface()
+    pts, tris, wall = surface(a.narrowing, a.aspect, a.shift)
     meshio.write(a.out, meshio.Mesh(pts, [("triangle", tris)], point_data={"wall_thickness": wall}), binary=True)
     if a.stl:
         meshio.write(a.stl, meshio.Mesh(pts, [("triangle", tris)]), binary=True)
