@@ -10,8 +10,9 @@ Each wall interface is then the lumen section moved outward along the same rays 
 interfaces of a star-shaped section moved radially never cross each other, whatever the thickness,
 which is what makes the layered wall robust on eccentric and elliptic lumens. The thickness so
 measured is radial, not normal to the lumen; for an ellipse of aspect ratio 1.5 the two differ by at
-most 8 % (the angle between radius and normal reaches atan((a^2 - b^2) / 2ab) = 22.6 deg). A section that is not star-shaped around its station point (a ray leaving the
-lumen twice: a kink, a fold, a bifurcation remnant) is refused."""
+most 8 % (the angle between radius and normal reaches atan((a^2 - b^2) / 2ab) = 22.6 deg). A
+section that is not star-shaped around its station point (a ray leaving the lumen twice: a kink, a
+fold, a bifurcation remnant) is refused."""
 import numpy as np
 import scipy.sparse
 import scipy.sparse.csgraph
