@@ -15,6 +15,7 @@ import scipy.sparse.linalg
 
 from .centerline_csv import arc_length
 from .errors import PatientInputError
+from .lumen_sections import level_cut
 
 
 def cotangent_laplacian(points, triangles):
@@ -66,49 +67,19 @@ def iso_directions(surface, u):
 
 def level_section(surface, u, c, iso):
     """(centroid, area vector, number of loops) of the level set u = c; iso from iso_directions."""
-    P, T = surface.points, surface.triangles
-    ut = u[T]
-    above = ut > c
-    cut = above.any(axis=1) & ~above.all(axis=1)
-    segs, keys = [], []
-    for t in np.flatnonzero(cut):
-        tri, vals = T[t], ut[t]
-        ends = []
-        for k in range(3):
-            a, b = tri[k], tri[(k + 1) % 3]
-            ua, ub = vals[k], vals[(k + 1) % 3]
-            if (ua > c) != (ub > c):
-                s = (c - ua) / (ub - ua)
-                ends.append((P[a] + s * (P[b] - P[a]), (min(a, b), max(a, b))))
-        if len(ends) != 2:
-            continue
-        # orient the segment so that u grows to its left on the triangle's outward side: then all segments
-        # of a loop run the same way round and 1/2 sum p x q is the area vector of the section
-        (p, kp), (q, kq) = ends
-        if np.dot(q - p, iso[t]) < 0:
-            (p, kp), (q, kq) = (q, kq), (p, kp)
-        segs.append((p, q))
-        keys.append((kp, kq))
-    if not segs:
+    got = level_cut(surface.points, surface.triangles, u, c)
+    if got is None:
         return None, None, 0
-    p = np.array([s[0] for s in segs])
-    q = np.array([s[1] for s in segs])
+    seg, _, _, tri, loop = got
+    # orient each segment so that u grows to its left on the triangle's outward side: then all segments
+    # of a loop run the same way round and 1/2 sum p x q is the area vector of the section
+    flip = np.einsum("ij,ij->i", seg[:, 1] - seg[:, 0], iso[tri]) < 0
+    p = np.where(flip[:, None], seg[:, 1], seg[:, 0])
+    q = np.where(flip[:, None], seg[:, 0], seg[:, 1])
     area = 0.5 * np.cross(p, q).sum(axis=0)
     length = np.linalg.norm(q - p, axis=1)
     centroid = (0.5 * (p + q) * length[:, None]).sum(axis=0) / max(length.sum(), 1e-300)
-    # loops: connected components of the segments through the mesh edges they share
-    parent = {}
-
-    def find(x):
-        while parent.setdefault(x, x) != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    for ka, kb in keys:
-        parent[find(ka)] = find(kb)
-    loops = len({find(k) for k in parent})
-    return centroid, area, loops
+    return centroid, area, len(np.unique(loop))
 
 
 def lumen_centerline(surface, spacing=0.2, levels=400):

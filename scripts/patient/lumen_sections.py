@@ -39,6 +39,38 @@ def low_pass(samples, points=SPLINE_POINTS):
     return np.fft.irfft(c, n=n, axis=-1)[..., :: n // points]
 
 
+def level_cut(X, T, values, c):
+    """Where the piecewise-linear `values` (per vertex of the triangles T over the points X) cross c:
+    one segment per cut triangle, as (end points (m, 2, 3), the mesh edges they lie on (m, 2, 2 vertex
+    ids), their positions along those edges (m, 2), the triangles (m,), the loop of each segment (m,):
+    connected components through the mesh edges the segments share), or None where nothing crosses.
+    The plane cuts of the sections and the level sets of lumen_centerline.py."""
+    d = values - c
+    above = d[T] > 0.0
+    cut = np.flatnonzero(above.any(axis=1) & ~above.all(axis=1))
+    if not len(cut):
+        return None
+    ends, keys, edges, us = [], [], [], []
+    for k in range(3):
+        a, b = T[cut, k], T[cut, (k + 1) % 3]
+        cross = above[cut, k] != above[cut, (k + 1) % 3]
+        u = np.where(cross, d[a] / np.where(cross, d[a] - d[b], 1.0), 0.0)
+        ends.append(np.where(cross[:, None], X[a] + u[:, None] * (X[b] - X[a]), np.nan))
+        keys.append(np.where(cross, np.minimum(a, b) * len(X) + np.maximum(a, b), -1))
+        edges.append(np.stack([a, b], -1))
+        us.append(u)
+    ends, keys, edges, us = np.stack(ends, 1), np.stack(keys, 1), np.stack(edges, 1), np.stack(us, 1)
+    # each cut triangle crosses the level on exactly two of its edges
+    order = np.argsort(keys < 0, axis=1, kind="stable")[:, :2]
+    rows = np.arange(len(cut))[:, None]
+    seg, key, edge, eu = ends[rows, order], keys[rows, order], edges[rows, order], us[rows, order]
+    uniq, inv = np.unique(key, return_inverse=True)
+    inv = inv.reshape(-1, 2)
+    graph = scipy.sparse.coo_matrix((np.ones(len(inv)), (inv[:, 0], inv[:, 1])), shape=(len(uniq),) * 2)
+    _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
+    return seg, edge, eu, cut, label[inv[:, 0]]
+
+
 def _cross2(a, b):
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
@@ -59,34 +91,8 @@ class LumenSections:
         return "surface" if self.field is not None else "outer surface" if self.outer is not None else None
 
     def _cut(self, P, t):
-        """The segments of the plane cut of the surface: their end points (m, 2, 3), the mesh edges
-        they lie on (m, 2, 2 vertex ids) with the position along each edge (m, 2), and their loop."""
-        X, T = self.surface.points, self.surface.triangles
-        d = (X - P) @ t
-        above = d[T] > 0.0
-        cut = np.flatnonzero(above.any(axis=1) & ~above.all(axis=1))
-        if not len(cut):
-            return None
-        ends, keys, edges, us = [], [], [], []
-        for k in range(3):
-            a, b = T[cut, k], T[cut, (k + 1) % 3]
-            cross = above[cut, k] != above[cut, (k + 1) % 3]
-            u = np.where(cross, d[a] / np.where(cross, d[a] - d[b], 1.0), 0.0)
-            ends.append(np.where(cross[:, None], X[a] + u[:, None] * (X[b] - X[a]), np.nan))
-            keys.append(np.where(cross, np.minimum(a, b) * len(X) + np.maximum(a, b), -1))
-            edges.append(np.stack([a, b], -1))
-            us.append(u)
-        ends, keys, edges, us = np.stack(ends, 1), np.stack(keys, 1), np.stack(edges, 1), np.stack(us, 1)
-        # each cut triangle crosses the plane on exactly two of its edges
-        order = np.argsort(keys < 0, axis=1, kind="stable")[:, :2]
-        rows = np.arange(len(cut))[:, None]
-        seg, key, edge, eu = ends[rows, order], keys[rows, order], edges[rows, order], us[rows, order]
-        # loops: connected components of the segments through the mesh edges they cross
-        uniq, inv = np.unique(key, return_inverse=True)
-        inv = inv.reshape(-1, 2)
-        graph = scipy.sparse.coo_matrix((np.ones(len(inv)), (inv[:, 0], inv[:, 1])), shape=(len(uniq),) * 2)
-        _, label = scipy.sparse.csgraph.connected_components(graph, directed=False)
-        return seg, edge, eu, label[inv[:, 0]]
+        """level_cut of the surface by the plane through P normal to t."""
+        return level_cut(self.surface.points, self.surface.triangles, (self.surface.points - P) @ t, 0.0)
 
     def _rays(self, P, t, n1, n2, where, angles):
         """Where `angles` rays from P in the plane through P normal to t (theta from n1 towards n2) meet
@@ -96,7 +102,7 @@ class LumenSections:
         got = self._cut(P, t)
         if got is None:
             raise PatientInputError(f"{self.surface.path}: the section at {where} does not cut the lumen surface")
-        seg, edge, eu, loop = got
+        seg, edge, eu, _, loop = got
         a = np.stack([(seg[:, 0] - P) @ n1, (seg[:, 0] - P) @ n2], -1)
         b = np.stack([(seg[:, 1] - P) @ n1, (seg[:, 1] - P) @ n2], -1)
         theta = 2.0 * np.pi * np.arange(angles) / angles

@@ -12,7 +12,7 @@ w = W0 + W1 cos(theta) (theta around the tube, 0 along +x: a wall thicker on one
 - a C-shaped section around its centroid is refused, naming the station ("not star-shaped");
 - the meshed three-layer wall (tet10): its volume and its intima's equal the polar integrals
   L/2 int (r_out^2 - r_in^2) dtheta of the radial offsets (media and adventitia thickness from the
-  area-equivalent outer diameter, as artery_mesh.layer_radii) within 1 %, and no element is inverted;
+  area-equivalent outer diameter, as artery_mesh.layer_radii) within 0.5 %, and no element is inverted;
 - the wall from an outer surface (a circle around the tube) is the distance between the surfaces
   along each ray, within the chord errors; an outer surface cutting into the lumen is refused;
 - plaque from a label array: the sectors bound the labelled patches within a ray and a facet spacing
@@ -228,8 +228,11 @@ class LumenSections_(unittest.TestCase):
         print(
             f"intima {vol['intima'] / exact['intima'] - 1:+.2e}, wall {total / exact['wall'] - 1:+.2e}", file=sys.stderr
         )
-        self.assertLess(abs(vol["intima"] / exact["intima"] - 1), 0.01, (vol, exact))
-        self.assertLess(abs(total / exact["wall"] - 1), 0.01, (vol, exact))
+        # the loft goes through 16 low-passed samples: about 1e-3 mm off the ellipse (aspect 1.5), i.e.
+        # up to 2 x 1e-3 / (2 rho + w) ~ 7e-4 of the wall's area; 0.5 % leaves the tet10's curved-face
+        # error room (measured -3.2e-5 and -1.8e-4)
+        self.assertLess(abs(vol["intima"] / exact["intima"] - 1), 0.005, (vol, exact))
+        self.assertLess(abs(total / exact["wall"] - 1), 0.005, (vol, exact))
 
     def test_patient_pipeline_with_the_wall_from_the_surface(self):
         """patient.lumen_surface with wall.thickness from_surface: the report gives the sections' aspect
