@@ -183,15 +183,16 @@ def _pie_loft(occ, reg, s, P, t, n1, radii, radius_of):
 
 
 def section_at(sections, P, t, n1, n2, s, i):
-    """The section at loft station i; at an end station whose plane leaves the surface (a cut end not
-    normal to the centerline, the station within a hair of it), the next station's shape."""
+    """The section at station i, sections.sample's (rho, wall, labels); at an end station whose plane
+    leaves the surface (a cut end not normal to the centerline, the station within a hair of it), the
+    next station's."""
     try:
-        return sections.polar(P[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm")
+        return sections.sample(P[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm")
     except PatientInputError:
         if i not in (0, len(P) - 1):
             raise
         j = 1 if i == 0 else len(P) - 2
-        return sections.polar(P[j], t[j], n1[j], n2[j], f"s = {s[j]:.2f} mm (for the end at {s[i]:.2f} mm)")
+        return sections.sample(P[j], t[j], n1[j], n2[j], f"s = {s[j]:.2f} mm (for the end at {s[i]:.2f} mm)")
 
 
 def build_artery(
@@ -220,8 +221,8 @@ def build_artery(
         from .lumen_sections import low_pass
 
         polar = [section_at(sections, P, t, n1, n2, s, i) for i in range(len(P))]
-        r = low_pass([rho for rho, _ in polar])
-        w = low_pass([f for _, f in polar]) if sections.wall_from else np.repeat(w[:, None], r.shape[1], 1)
+        r = low_pass([p[0] for p in polar])
+        w = low_pass([p[1] for p in polar]) if sections.wall_from else np.repeat(w[:, None], r.shape[1], 1)
     radii, ti, tm, ta = layer_radii(r, w, spec, where)
     gmsh.initialize()
     try:

@@ -78,12 +78,14 @@ def _cross2(a, b):
 class LumenSections:
     """Sections of one lumen surface, with the wall thickness on the rays from `field` (a per-vertex
     array of the surface), or from `outer` (the LumenSections of an outer-wall surface: the thickness
-    is then the distance between the two surfaces along each ray), or neither."""
+    is then the distance between the two surfaces along each ray), or neither; and optionally per-vertex
+    `labels` sampled on the same rays."""
 
-    def __init__(self, surface, field=None, outer=None):
+    def __init__(self, surface, field=None, outer=None, labels=None):
         self.surface = surface
         self.field = None if field is None else np.asarray(field, dtype=float)
         self.outer = outer
+        self.labels = None if labels is None else np.asarray(labels)  # per vertex (plaque_labels.py)
 
     @property
     def wall_from(self):
@@ -143,7 +145,17 @@ class LumenSections:
 
     def polar(self, P, t, n1, n2, where, angles=ANGLES):
         """(rho, wall thickness or None) on `angles` rays from P (see _rays)."""
+        return self.sample(P, t, n1, n2, where, angles)[:2]
+
+    def sample(self, P, t, n1, n2, where, angles=ANGLES):
+        """(rho, wall thickness or None, labels or None) on `angles` rays from P (see _rays): the
+        labels are those of the surface vertex nearest each hit."""
         rho, edge, eu, u = self._rays(P, t, n1, n2, where, angles)
+        label = None
+        if self.labels is not None:
+            end = np.where(u < 0.5, 0, 1)
+            rows = np.arange(len(u))
+            label = self.labels[edge[rows, end, np.where(eu[rows, end] < 0.5, 0, 1)]]
         if self.outer is not None:
             outer, _ = self.outer.polar(P, t, n1, n2, where, angles)
             k = int(np.argmin(outer - rho))
@@ -153,19 +165,12 @@ class LumenSections:
                     f"{self.surface.path} towards {360.0 * k / angles:.0f} degrees ({outer[k]:.3f} mm against "
                     f"{rho[k]:.3f} mm from the centerline): expected an outer surface around the lumen"
                 )
-            return rho, outer - rho
+            return rho, outer - rho, label
         if self.field is None:
-            return rho, None
+            return rho, None, label
         f = self.field[edge]  # (K, 2 segment ends, 2 edge vertices)
         ends = f[..., 0] + eu * (f[..., 1] - f[..., 0])
-        return rho, ends[:, 0] + u * (ends[:, 1] - ends[:, 0])
-
-    def labels(self, values, P, t, n1, n2, where, angles=ANGLES):
-        """A per-vertex label array on the rays: the label of the surface vertex nearest each hit."""
-        _, edge, eu, u = self._rays(P, t, n1, n2, where, angles)
-        end = np.where(u < 0.5, 0, 1)
-        rows = np.arange(len(u))
-        return np.asarray(values)[edge[rows, end, np.where(eu[rows, end] < 0.5, 0, 1)]]
+        return rho, ends[:, 0] + u * (ends[:, 1] - ends[:, 0]), label
 
 
 def inscribed_radius(rho):

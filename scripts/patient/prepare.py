@@ -143,17 +143,18 @@ def add_insertion(done, plc, dev, ins, scene_path):
 
 
 def lumen_csv(pat, scene_path, out_dir, log):
-    """(CSV, sections) of the scene: patient.centerline as given; or, with patient.lumen_surface, a CSV
-    in out_dir/lumen_from_surface.csv (the centerline computed from the surface, or the given one,
-    with the area-equivalent radius of the surface's sections) and the surface's true sections
-    (lumen_sections.LumenSections, None for circles)."""
+    """(CSV, sections, plaque labels' spec) of the scene: patient.centerline as given; or, with
+    patient.lumen_surface, a CSV in out_dir/lumen_from_surface.csv (the centerline computed from the
+    surface, or the given one, with the area-equivalent radius of the surface's sections), the
+    surface's true sections (lumen_sections.LumenSections, None for circles) and the checked
+    patient.lumen_surface.plaque (None without)."""
     if not pat["centerline"] and not pat["lumen_surface"]:
         raise PatientInputError(
             f"{scene_path}: patient: expected centerline (a CSV), lumen_surface ({{file, units}}), or both (the "
             "CSV's centerline through the surface's sections), got neither"
         )
     if not pat["lumen_surface"]:
-        return (scene_path.parent / pat["centerline"]).resolve(), None
+        return (scene_path.parent / pat["centerline"]).resolve(), None, None
     spec = scene_keys.check_map(pat["lumen_surface"], "patient.lumen_surface", scene_path, PatientInputError)
     path = (scene_path.parent / spec["file"]).resolve()
     surface = read_lumen_surface(str(path), spec["units"])
@@ -178,50 +179,40 @@ def lumen_csv(pat, scene_path, out_dir, log):
         raise PatientInputError(
             f"{scene_path}: patient.wall.thickness: from_outer_surface needs patient.outer_surface ({{file, units}})"
         )
+    key = "patient.lumen_surface.plaque"
+    plaque = scene_keys.check_map(spec["plaque"], key, scene_path, PatientInputError) if spec["plaque"] else None
     if spec["sections"] == "circles":
         if thickness in ("from_surface", "from_outer_surface"):
             raise PatientInputError(
                 f"{scene_path}: patient.wall.thickness: {thickness} needs patient.lumen_surface.sections: surface"
             )
-        return out, None
+        if plaque:
+            raise PatientInputError(f"{scene_path}: {key}: needs patient.lumen_surface.sections: surface")
+        return out, None, None
+    labels = None
+    if plaque:
+        if not plaque["types"] or not all(isinstance(x, str) for x in plaque["types"]):
+            raise PatientInputError(
+                f"{scene_path}: {key}.types: expected a list of plaque type names, got {plaque['types']!r}"
+            )
+        labels = read_labels(str(path), surface, plaque["array"])
+    wall = {}
     if thickness == "from_surface":
-        return out, LumenSections(surface, field=read_wall_field(str(path), surface, spec["wall_array"]))
-    if thickness == "from_outer_surface":
+        wall["field"] = read_wall_field(str(path), surface, spec["wall_array"])
+    elif thickness == "from_outer_surface":
         o = scene_keys.check_map(pat["outer_surface"], "patient.outer_surface", scene_path, PatientInputError)
-        outer = read_lumen_surface(str((scene_path.parent / o["file"]).resolve()), o["units"])
-        return out, LumenSections(surface, outer=LumenSections(outer))
-    return out, LumenSections(surface)
+        wall["outer"] = LumenSections(read_lumen_surface(str((scene_path.parent / o["file"]).resolve()), o["units"]))
+    return out, LumenSections(surface, labels=labels, **wall), plaque
 
 
 def station_sections(cl, sections):
-    """Per centerline station of cl: the sections' polar lumen radius and wall field (n, K) (the
-    field None without one) and the clearance radius (n,), in the loft's frames."""
+    """Per centerline station of cl, in the loft's frames: the sections' polar lumen radius (n, K),
+    wall (n, K) and labels (n, K) (each None where the sections have none), and the clearance radius (n,)."""
     t, n1, n2 = section_frames(cl.points)
     s = cl.arc_length
-    polar = [section_at(sections, cl.points, t, n1, n2, s, i) for i in range(len(s))]
-    rho = np.array([r for r, _ in polar])
-    field = np.array([f for _, f in polar]) if sections.wall_from else None
-    return rho, field, np.array([inscribed_radius(r) for r in rho])
-
-
-def plaque_from_surface(pat, cl, sections, scene_path):
-    """The patient.plaque entries of patient.lumen_surface.plaque (plaque_labels.py), or []."""
-    surf = pat["lumen_surface"] or {}
-    if not surf.get("plaque"):
-        return []
-    key = "patient.lumen_surface.plaque"
-    spec = scene_keys.check_map(surf["plaque"], key, scene_path, PatientInputError)
-    if sections is None:
-        raise PatientInputError(f"{scene_path}: {key}: needs patient.lumen_surface.sections: surface")
-    if not spec["types"] or not all(isinstance(x, str) for x in spec["types"]):
-        raise PatientInputError(
-            f"{scene_path}: {key}.types: expected a list of plaque type names, got {spec['types']!r}"
-        )
-    labels = read_labels(sections.surface.path, sections.surface, spec["array"])
-    t, n1, n2 = section_frames(cl.points)
-    s = cl.arc_length
-    grid = [sections.labels(labels, cl.points[i], t[i], n1[i], n2[i], f"s = {s[i]:.2f} mm") for i in range(len(s))]
-    return regions_from_labels(np.array(grid), s, spec["types"], spec["thickness"], f"{scene_path}: {key}")
+    got = [section_at(sections, cl.points, t, n1, n2, s, i) for i in range(len(s))]
+    rho, wall, labels = (None if got[0][k] is None else np.array([g[k] for g in got]) for k in range(3))
+    return rho, wall, labels, np.array([inscribed_radius(r) for r in rho])
 
 
 def prepare_scene(scene, scene_path, out_dir, log=print):
@@ -242,7 +233,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         )
     dev = device_of(scene, scene_path)
 
-    csv_path, sections = lumen_csv(pat, scene_path, Path(out_dir), log)
+    csv_path, sections, label_spec = lumen_csv(pat, scene_path, Path(out_dir), log)
     cl = read_centerline_csv(csv_path)
     if wall["thickness"] in ("from_surface", "from_outer_surface") and not pat["lumen_surface"]:
         raise PatientInputError(
@@ -273,9 +264,12 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     # the lumen and wall per station as the mesh will have them: the true sections (n, K) when the
     # surface gives them; the devices must then clear the largest circle inside each section
     # around its centerline point, not the area-equivalent one
-    r_lumen, w_lumen, cl_fit = cl.radius, wall_t, cl
+    r_lumen, w_lumen, cl_fit, from_labels = cl.radius, wall_t, cl, []
     if sections is not None:
-        r_lumen, field, r_clear = station_sections(cl, sections)
+        r_lumen, field, labels, r_clear = station_sections(cl, sections)
+        if label_spec:
+            key = f"{scene_path}: patient.lumen_surface.plaque"
+            from_labels = regions_from_labels(labels, cl.arc_length, label_spec["types"], label_spec["thickness"], key)
         w_lumen = field if field is not None else np.repeat(wall_t[:, None], r_lumen.shape[1], 1)
         if wall_t is None:
             wall_t = w_lumen.mean(axis=1)
@@ -291,7 +285,6 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     spec = WallSpec(
         media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"], min_intima=wall["min_intima"]
     )
-    from_labels = plaque_from_surface(pat, cl, sections, scene_path)
     if from_labels:
         log(f"patient: {len(from_labels)} plaque regions from the surface's labels")
     plaque = read_plaque((pat["plaque"] or []) + from_labels, float(cl.arc_length[-1]), scene_path)

@@ -148,9 +148,9 @@ class LumenSections_(unittest.TestCase):
         (3.75 deg) of the labelled angles, within half a station plus the rings' spacing (0.2 mm) of the
         labelled z; a patch across angle 0 is one sector through 0; too many labels are refused."""
         t, n1, n2 = self.frame
-        labels = read_labels(self.path, self.surface, "plaque")
+        labelled = LumenSections(self.surface, labels=read_labels(self.path, self.surface, "plaque"))
         z = np.linspace(0.1, LENGTH - 0.1, 59)
-        grid = [self.sections.labels(labels, np.array([E, 0.0, zi]), t, n1, n2, f"z = {zi}") for zi in z]
+        grid = [labelled.sample(np.array([E, 0.0, zi]), t, n1, n2, f"z = {zi}")[2] for zi in z]
         got = regions_from_labels(np.array(grid), z - z[0], ["calcified", "lipid"], 0.3, "test")
         self.assertEqual([e["type"] for e in got], ["calcified", "lipid"])
         for e, (a0, a1, z0, z1) in zip(got, ((30, 90, 2.0, 4.0), (200, 260, 2.5, 3.5))):
@@ -183,7 +183,7 @@ class LumenSections_(unittest.TestCase):
         pat = {"centerline": given, "lumen_surface": {"file": self.path}, "wall": {"thickness": "from_centerline"}}
         out = Path(self.tmp) / "given"
         out.mkdir(exist_ok=True)
-        csv, sections = lumen_csv(dict(pat, outer_surface=None), Path(self.tmp) / "scene.yaml", out, lambda m: None)
+        csv, sections, _ = lumen_csv(dict(pat, outer_surface=None), Path(self.tmp) / "scene.yaml", out, lambda m: None)
         cl = read_centerline_csv(csv)
         self.assertLess(np.abs(cl.points - pts).max(), 1e-6)
         self.assertLess(np.abs(cl.radius / np.sqrt(A * B) - 1).max(), 2e-3)
