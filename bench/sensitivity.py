@@ -15,8 +15,8 @@ base's, a map or list as a whole (to change one layer of artery.mesh.layers, giv
 
 Outputs of each run (work_precision.outputs_of, from scripts/report.py's results.json): stent
 diameter at peak and final (mm), recoil and dogboning (%), for an artery the max and 99th-percentile
-first principal stress per layer at peak and after (MPa). Difference of an output: (q - q_baseline) /
-|q_baseline| in %.
+first principal stress per layer at peak and after and its recovered nodal maximum (MPa).
+Difference of an output: (q - q_baseline) / |q_baseline| in %.
 
 Written to OUT_DIR (default runs/sensitivity/<study>): sensitivity.json and .csv (one row per run:
 name, status, wall time, every output and its difference) and run-<hash>/ per run. Printed: a
@@ -105,11 +105,11 @@ def load_study(path):
 
 
 def columns(rows):
-    """The table's outputs: diameters, then per layer (in results.json order) max/p99 at peak, after."""
+    """The table's outputs: diameters, then per layer (in results.json order) max/p99/nodal max at peak, after."""
     names = [n for r in rows for n in r["outputs"]]
     layers = dict.fromkeys(n.split("_max_")[0] for n in names if "_max_" in n)
     return ["D_peak", "D_final"] + [
-        f"{layer}_{s}_{ph}" for ph in ("peak", "after") for layer in layers for s in ("max", "p99")
+        f"{layer}_{s}_{ph}" for ph in ("peak", "after") for layer in layers for s in ("max", "p99", "max_nodal")
     ]
 
 

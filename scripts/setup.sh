@@ -10,6 +10,8 @@ PACKAGES=(
   flatbuffers-compiler libflatbuffers-dev libyaml-cpp-dev nlohmann-json3-dev libssl-dev
   libgtest-dev googletest
   python3 python3-numpy python3-scipy python3-matplotlib python3-h5py python3-yaml python3-gmsh python3-meshio
+  # VTK XML PolyData (.vtp) lumen surfaces and centerlines (scripts/patient/surface_file.py)
+  python3-vtk9
   # studies as Slurm job arrays (scripts/study.py --runner slurm); the test starts its own one-node cluster
   slurm-client slurmctld slurmd munge
   # participants in separate network namespaces (tests/integration/test_network_namespaces.py)

@@ -91,24 +91,28 @@ def read_centerline_csv(path):
                     f"{path}:{line_no}: column {cols[j]}: expected a finite number, got {v.strip()}"
                 )
             data[k, j] = x
-    if len(rows) < 4:
-        raise PatientInputError(
-            f"{path}: expected at least 4 centerline points (a cubic spline needs them), got {len(rows)}"
-        )
     col = {c: data[:, j] for j, c in enumerate(cols)}
     pts = np.column_stack([col["x"], col["y"], col["z"]])
-    r = col["r"]
-    for k in range(len(rows)):
+    return checked_centerline(path, pts, col["r"], col.get("wall"), lambda k: f"{path}:{rows[k][0]}: ")
+
+
+def checked_centerline(path, pts, r, wall, where):
+    """The centerline (n, 3) with its radius and wall (None: not given), or PatientInputError:
+    at least 4 points, positive radii and walls, distinct consecutive points, no turn beyond 90°.
+    `where(k)` names point k in a message (a CSV's line, a VTP's point id)."""
+    if len(pts) < 4:
+        raise PatientInputError(
+            f"{path}: expected at least 4 centerline points (a cubic spline needs them), got {len(pts)}"
+        )
+    for k in range(len(pts)):
         if not r[k] > 0:
-            raise PatientInputError(
-                f"{path}:{rows[k][0]}: column r: expected a positive lumen radius (mm), got {r[k]:g}"
-            )
+            raise PatientInputError(f"{where(k)}radius: expected a positive lumen radius (mm), got {r[k]:g}")
     seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     scale = max(float(np.ptp(pts, axis=0).max()), 1e-300)
     for k in np.nonzero(seg <= 1e-9 * scale)[0]:
         raise PatientInputError(
-            f"{path}:{rows[k + 1][0]}: expected distinct consecutive points, got the point of line "
-            f"{rows[k][0]} repeated ({pts[k, 0]:g}, {pts[k, 1]:g}, {pts[k, 2]:g})"
+            f"{where(k + 1)}expected distinct consecutive points, got the point before repeated "
+            f"({pts[k, 0]:g}, {pts[k, 1]:g}, {pts[k, 2]:g})"
         )
     # a centerline that doubles back is not a vessel: consecutive segments turning by more than 90°
     if len(seg) >= 2:
@@ -116,18 +120,14 @@ def read_centerline_csv(path):
         cosang = np.einsum("ij,ij->i", t[:-1], t[1:])
         for k in np.nonzero(cosang < 0)[0]:
             raise PatientInputError(
-                f"{path}:{rows[k + 1][0]}: expected a centerline without reversals, got a turn of "
+                f"{where(k + 1)}expected a centerline without reversals, got a turn of "
                 f"{math.degrees(math.acos(max(-1.0, cosang[k]))):.0f}° at this point"
             )
-    wall = None
-    if "wall" in col:
-        wall = col["wall"]
-        for k in range(len(rows)):
+    if wall is not None:
+        for k in range(len(pts)):
             if not wall[k] > 0:
-                raise PatientInputError(
-                    f"{path}:{rows[k][0]}: column wall: expected a positive wall thickness (mm), got {wall[k]:g}"
-                )
-    return LumenCenterline(path=str(path), points=pts, radius=r, wall=wall)
+                raise PatientInputError(f"{where(k)}wall: expected a positive wall thickness (mm), got {wall[k]:g}")
+    return LumenCenterline(path=str(path), points=pts, radius=np.asarray(r), wall=wall)
 
 
 def write_centerline_csv(path, points, radius, wall=None, comment=""):

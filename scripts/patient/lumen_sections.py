@@ -187,14 +187,14 @@ def inscribed_radius(rho):
 def point_array(surface_path, surface, name, what):
     """The point-data array `name` of the surface file (`what` it holds, for messages), on the merged
     vertices of `surface`: one finite value per vertex."""
-    import meshio
+    from .surface_file import read_mesh
 
-    mesh = meshio.read(surface_path)
+    mesh = read_mesh(surface_path, f"a surface with the point data array '{name}'")
     if name not in mesh.point_data:
         have = ", ".join(sorted(mesh.point_data)) or "none"
         raise PatientInputError(
             f"{surface_path}: expected a point data array '{name}' ({what}), got arrays: {have} "
-            "(STL carries none: write VTK, VTU or PLY)"
+            "(STL carries none: write VTP, VTK, VTU or PLY)"
         )
     values = np.asarray(mesh.point_data[name], dtype=float)
     if values.ndim == 2 and values.shape[1] == 1:

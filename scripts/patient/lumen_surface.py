@@ -1,5 +1,5 @@
-"""Reading a segmented lumen surface (STL, OBJ, PLY, VTK, VTU, ... : what meshio reads), in mm, open at
-both ends, as a checked triangle mesh: duplicate vertices merged (STL stores every facet's corners),
+"""Reading a segmented lumen surface (STL, VTP, OBJ, PLY, VTK, VTU, ...: surface_file.read_mesh), in
+mm, open at both ends, as a checked triangle mesh: duplicate vertices merged (STL stores every facet's corners),
 every edge shared by at most two triangles, consistently oriented, exactly two boundary loops (the
 vessel's cut ends). A surface in metres (SimVascular's and some VMTK exports) is recognised by its
 size and refused unless `units: m` converts it. Every refusal is a PatientInputError naming the file
@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import PatientInputError
+from .surface_file import read_mesh
 
 MAX_BYTES = 512 * 2**20  # a segmented coronary lumen is a few MB; refuse anything that cannot be one
 UNITS = {"mm": 1.0, "m": 1000.0, "cm": 10.0}
@@ -30,18 +31,11 @@ class LumenSurface:
 
 def read_lumen_surface(path, units="mm"):
     """The checked surface, or PatientInputError naming the file and the problem."""
-    import meshio  # only the surface route needs it (python3-meshio)
-
     if units not in UNITS:
         raise PatientInputError(f"{path}: units: expected one of {', '.join(UNITS)}, got {units!r}")
-    if not os.path.isfile(path):
-        raise PatientInputError(f"{path}: no such file (a lumen surface: STL, OBJ, PLY, VTK, VTU)")
-    if os.path.getsize(path) > MAX_BYTES:
+    if os.path.isfile(path) and os.path.getsize(path) > MAX_BYTES:
         raise PatientInputError(f"{path}: {os.path.getsize(path)} bytes, expected a lumen surface below {MAX_BYTES}")
-    try:
-        mesh = meshio.read(path)
-    except Exception as e:  # meshio raises many types for unreadable files
-        raise PatientInputError(f"{path}: cannot read a surface with meshio: {type(e).__name__}: {e}")
+    mesh = read_mesh(path, "a lumen surface: STL, VTP, OBJ, PLY, VTK, VTU")
     tris = [c.data for c in mesh.cells if c.type == "triangle"]
     if not tris:
         kinds = ", ".join(sorted({c.type for c in mesh.cells})) or "none"

@@ -24,6 +24,7 @@ import scene_keys
 
 from .artery_mesh import WallSpec, build_artery, layer_radii, section_at, section_frames
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
+from .centerline_vtp import read_centerline
 from .errors import PatientInputError
 from .lumen_centerline import lumen_centerline
 from .lumen_sections import LumenSections, inscribed_radius, read_wall_field
@@ -143,25 +144,32 @@ def add_insertion(done, plc, dev, ins, scene_path):
 
 
 def lumen_csv(pat, scene_path, out_dir, log):
-    """(CSV, sections, plaque labels' spec) of the scene: patient.centerline as given; or, with
+    """(CSV, sections, plaque labels' spec) of the scene: patient.centerline as given (a VTP written as
+    out_dir/lumen_from_centerline.csv); or, with
     patient.lumen_surface, a CSV in out_dir/lumen_from_surface.csv (the centerline computed from the
     surface, or the given one, with the area-equivalent radius of the surface's sections), the
     surface's true sections (lumen_sections.LumenSections, None for circles) and the checked
     patient.lumen_surface.plaque (None without)."""
     if not pat["centerline"] and not pat["lumen_surface"]:
         raise PatientInputError(
-            f"{scene_path}: patient: expected centerline (a CSV), lumen_surface ({{file, units}}), or both (the "
+            f"{scene_path}: patient: expected centerline (a CSV or VTP), lumen_surface ({{file, units}}), or both (the "
             "CSV's centerline through the surface's sections), got neither"
         )
     if not pat["lumen_surface"]:
-        return (scene_path.parent / pat["centerline"]).resolve(), None, None
+        given = (scene_path.parent / pat["centerline"]).resolve()
+        if given.suffix.lower() != ".vtp":
+            return given, None, None
+        cl = read_centerline(given)  # VTK PolyData (VMTK, SimVascular): written as our CSV
+        out = out_dir / "lumen_from_centerline.csv"
+        write_centerline_csv(out, cl.points, cl.radius, wall=cl.wall, comment=f"centerline of {given}")
+        return out, None, None
     spec = scene_keys.check_map(pat["lumen_surface"], "patient.lumen_surface", scene_path, PatientInputError)
     path = (scene_path.parent / spec["file"]).resolve()
     surface = read_lumen_surface(str(path), spec["units"])
     out = out_dir / "lumen_from_surface.csv"
     if pat["centerline"]:  # the given centerline; its radius from the surface (sqrt(A / pi) of each section)
         csv = (scene_path.parent / pat["centerline"]).resolve()
-        given = read_centerline_csv(csv)
+        given = read_centerline(csv)
         points, wall = given.points, given.wall
         t, n1, n2 = section_frames(points)
         s = given.arc_length
