@@ -376,18 +376,29 @@ def _size_hint(ti, tm, ta, mesh_size):
     )
 
 
-def _min_quadratic_jacobian():
-    """Smallest Jacobian determinant of the tet10 elements at their Gauss points (gmsh's own)."""
+def _jacobian_samples():
+    """(element tags, nodes (ne, 10), det J (ne, ns), straight-sided det J (ne,), corners (ne, 4, 3))
+    of the tet10 at the samples every validity check uses: the Gauss points and the ten nodes (a
+    curved tet10 can fold at a corner while its Gauss points stay positive)."""
     import gmsh
 
-    lo = math.inf
-    types, _, _ = gmsh.model.mesh.getElements(3)
-    for et in types:
-        pts, _ = gmsh.model.mesh.getIntegrationPoints(et, "Gauss4")
-        _, dets, _ = gmsh.model.mesh.getJacobians(et, pts)
-        if len(dets):
-            lo = min(lo, float(np.min(dets)))
-    return lo
+    tags, nodes = gmsh.model.mesh.getElementsByType(11)
+    gauss, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
+    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+    mids = np.array([0.5 * (corners[a] + corners[b]) for a, b in TET10_EDGES])
+    local = np.concatenate([gauss, corners.ravel(), mids.ravel()])
+    _, dets, coords = gmsh.model.mesh.getJacobians(11, local)
+    dets = np.asarray(dets).reshape(len(tags), -1)
+    ng = len(gauss) // 3
+    c = np.asarray(coords).reshape(len(tags), -1, 3)[:, ng : ng + 4]
+    straight = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
+    return tags, np.asarray(nodes).reshape(-1, 10), dets, straight, c
+
+
+def _min_quadratic_jacobian():
+    """Smallest Jacobian determinant of the tet10 at the samples of _jacobian_samples."""
+    dets = _jacobian_samples()[2]
+    return float(dets.min()) if dets.size else math.inf
 
 
 def _min_scaled_jacobian():
@@ -395,22 +406,9 @@ def _min_scaled_jacobian():
     det J of the element's straight-sided tet4 (1 for a straight-sided tet10, <= 0 inverted or
     folded; the measure gmsh's high-order optimizer works on), and the centroid of the worst element.
     gmsh 4.8's own quality API has no scaled Jacobian, so it is computed from getJacobians."""
-    import gmsh
-
-    tags, nodes = gmsh.model.mesh.getElementsByType(11)
+    tags, _, dets, straight, c = _jacobian_samples()
     if not len(tags):
         return math.nan, np.zeros(3)
-    gauss, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
-    corners = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
-    mids = np.array([0.5 * (corners[a] + corners[b]) for a, b in TET10_EDGES])
-    local = np.concatenate([gauss, corners.ravel(), mids.ravel()])
-    _, dets, coords = gmsh.model.mesh.getJacobians(11, local)
-    dets = dets.reshape(len(tags), -1)
-    # the straight-sided tet4's det J from its corners: the 4 corner sample points' coordinates
-    xyz = coords.reshape(len(tags), -1, 3)
-    ng = len(gauss) // 3
-    c = xyz[:, ng : ng + 4]
-    straight = np.einsum("ij,ij->i", c[:, 1] - c[:, 0], np.cross(c[:, 2] - c[:, 0], c[:, 3] - c[:, 0]))
     q = dets.min(axis=1) / straight
     k = int(np.argmin(q))
     return float(q[k]), c[k].mean(axis=0)
@@ -421,23 +419,19 @@ TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
 
 
 def _straighten_inverted(max_rounds=5):
-    """Moves the mid-edge nodes of tet10 with a non-positive Jacobian to their edge midpoints (a
-    straight-sided tet10 is valid whenever its tet4 is); returns how many elements were changed."""
+    """Moves the mid-edge nodes of tet10 with a non-positive Jacobian (at any sample of
+    _jacobian_samples) to their edge midpoints (a straight-sided tet10 is valid whenever its tet4
+    is); returns how many elements were changed."""
     import gmsh
 
     changed = set()
     for _ in range(max_rounds):
-        pts, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss4")
-        tags, nodes = gmsh.model.mesh.getElementsByType(11)
-        _, dets, _ = gmsh.model.mesh.getJacobians(11, pts)
-        ng = len(pts) // 3
-        bad = np.nonzero(dets.reshape(len(tags), ng).min(axis=1) <= 0.0)[0]
+        tags, nodes, dets, _, corner = _jacobian_samples()
+        bad = np.nonzero(dets.min(axis=1) <= 0.0)[0]
         if not len(bad):
             break
-        nodes = nodes.reshape(-1, 10)
         for e in bad:
             changed.add(int(tags[e]))
-            corner = [np.array(gmsh.model.mesh.getNode(int(nodes[e, a]))[0]) for a in range(4)]
             for k, (a, b) in enumerate(TET10_EDGES):
-                gmsh.model.mesh.setNode(int(nodes[e, 4 + k]), list(0.5 * (corner[a] + corner[b])), [])
+                gmsh.model.mesh.setNode(int(nodes[e, 4 + k]), list(0.5 * (corner[e, a] + corner[e, b])), [])
     return len(changed)
