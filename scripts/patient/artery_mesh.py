@@ -12,6 +12,7 @@ conforming layers and the lumen core removed.
 Physical groups (the names the solid solver and the scene use): volumes `intima`, `media`,
 `adventitia`; surfaces `endothelium` (lumen wall), `outer`, `end0` (first station), `end1`.
 """
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -133,36 +134,62 @@ def _section_curves(occ, center, p, n1, n2, R, a0=0.0, a1=None):
     return rim if closed else [occ.addLine(center, q[0])] + rim + [occ.addLine(q[-1], center)]
 
 
-def _sector_solids(occ, regions, s, P, t, n1, radii):
-    """One OCC solid per plaque region: a loft through pie-slice sections in the normal planes at
-    from_s, the loft stations between and to_s, from the centerline out to the lumen radius plus
-    offset + thickness (or into the media: to the intima's outer surface), less the pie slice out to
-    the lumen radius plus offset when the region starts below the lumen. The slice's part in the
-    lumen core is removed with the core; only its part in the intima becomes plaque."""
-    out = []
+def _plaque_tools(occ, regions, s, P, t, n1, radii):
+    """The OCC solids that carve the plaque regions out of the intima, and for each region which of
+    them bound it: one loft per distinct sector (from_s, to_s, angle) through pie slices from the
+    centerline (closed sections for a full circle) out past the regions' depths, and one per
+    distinct depth bound d (a region's offset > 0, its offset + thickness) over its sector's stretch,
+    through closed sections at the lumen radius + d. A region is the intima inside its sector's pie,
+    outside its offset's loft and inside its offset + thickness' loft. Regions stacked in depth over
+    one sector (a fibrous cap over a lipid pool) thus share the pie's flat sides instead of bringing
+    two separately lofted copies of them, which OpenCASCADE's fragment cannot merge on a curved
+    centerline (overlapping facets, pieces outside the wall). The pie reaches halfway from the deepest
+    bound to the intima's outer surface, or halfway into the media when a region reaches the intima's
+    outer surface (thickness None), so that its rim coincides with no other surface.
+    Returns (solids: list of dimtag lists, of_region: [(pie, inner or None, outer or None)] indices)."""
+    solids, pie_of, depth_of, of_region = [], {}, {}, []
+
+    def tool(key, index, build):
+        if key not in index:
+            index[key] = len(solids)
+            solids.append([dt for dt in build() if dt[0] == 3])
+        return index[key]
+
     for reg in regions:
-        outer = _pie_loft(
-            occ,
-            reg,
-            s,
-            P,
-            t,
-            n1,
-            radii,
-            lambda lumen, i_out, m_out: (
-                lumen + reg.offset + reg.thickness if reg.thickness is not None else 0.5 * (i_out + m_out)
-            ),
-        )
-        if reg.offset > 0.0:
-            inner = _pie_loft(occ, reg, s, P, t, n1, radii, lambda lumen, i_out, m_out: lumen + reg.offset)
-            outer, _ = occ.cut(outer, inner)
-        out.append([dt for dt in outer if dt[0] == 3])
-    return out
+        sector = (reg.from_s, reg.to_s, tuple(reg.angle))
+        same = [r for r in regions if (r.from_s, r.to_s, tuple(r.angle)) == sector]
+        deepest = max((r.offset + r.thickness for r in same if r.thickness is not None), default=0.0)
+        to_media = any(r.thickness is None for r in same)
+
+        def rim(lumen, i_out, m_out, reg, deepest=deepest, to_media=to_media):
+            return 0.5 * (i_out + m_out) if to_media else 0.5 * (lumen + deepest + i_out)
+
+        pie = tool(sector, pie_of, lambda: _sector_loft(occ, reg, s, P, t, n1, radii, rim))
+        bounds = []
+        for d in (
+            reg.offset if reg.offset > 0.0 else None,
+            None if reg.thickness is None else reg.offset + reg.thickness,
+        ):
+            if d is None:
+                bounds.append(None)
+                continue
+            whole = dataclasses.replace(reg, angle=(0.0, 360.0))
+            bounds.append(
+                tool(
+                    (reg.from_s, reg.to_s, d),
+                    depth_of,
+                    lambda d=d, whole=whole: _sector_loft(
+                        occ, whole, s, P, t, n1, radii, lambda lumen, i_out, m_out, reg: lumen + d
+                    ),
+                )
+            )
+        of_region.append((pie, bounds[0], bounds[1]))
+    return solids, of_region
 
 
-def _pie_loft(occ, reg, s, P, t, n1, radii, radius_of):
-    """The loft through the region's pie-slice sections of radius radius_of(lumen, intima's outer,
-    media's outer radius) per section."""
+def _sector_loft(occ, reg, s, P, t, n1, radii, radius_of):
+    """The loft through the region's sections of radius radius_of(lumen, intima's outer, media's
+    outer radius, region) per section: closed curves for a full circle, else pie slices."""
     ss = np.concatenate([[reg.from_s], s[(s > reg.from_s + 1e-6) & (s < reg.to_s - 1e-6)], [reg.to_s]])
     Pk = np.column_stack([np.interp(ss, s, P[:, c]) for c in range(3)])
     tk = np.column_stack([np.interp(ss, s, t[:, c]) for c in range(3)])
@@ -171,7 +198,7 @@ def _pie_loft(occ, reg, s, P, t, n1, radii, radius_of):
     nk -= np.einsum("ij,ij->i", nk, tk)[:, None] * tk
     nk /= np.linalg.norm(nk, axis=1)[:, None]
     bk = np.cross(tk, nk)
-    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(3)))
+    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(3)), reg)
     a0, a1 = (math.radians(a) for a in reg.angle)
     wires = []
     for i in range(len(ss)):
@@ -238,18 +265,26 @@ def build_artery(
             vol = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
             solids.append([dt for dt in vol if dt[0] == 3])
         all_in = [dt for sl in solids for dt in sl]
-        sectors = _sector_solids(occ, plaque, s, P, t, n1, radii)
-        _, pieces_of = occ.fragment(all_in + [dt for sl in sectors for dt in sl], [])
+        tools, tools_of = _plaque_tools(occ, plaque, s, P, t, n1, radii)
+        flat = [(k, dt) for k, sl in enumerate(tools) for dt in sl]
+        _, pieces_of = occ.fragment(all_in + [dt for _, dt in flat], [])
         occ.synchronize()
         # a piece inside k of the four nested solids: 4 = lumen core, 3 intima, 2 media, 1 adventitia;
-        # an intima piece inside a plaque region's solid is that region's plaque
-        count, region_of = {}, {}
+        # an intima piece inside a region's pie, outside its offset's loft and inside its offset +
+        # thickness' loft is that region's plaque
+        count, inside = {}, {}
         for i, inp in enumerate(pieces_of):
             for dt in inp:
                 if i < len(all_in):
                     count[dt] = count.get(dt, 0) + 1
                 else:
-                    region_of[dt] = plaque[i - len(all_in)].layer
+                    inside.setdefault(dt, set()).add(flat[i - len(all_in)][0])
+        region_of = {}
+        for dt, tags in inside.items():
+            for reg, (pie, inner, outer) in zip(plaque, tools_of):
+                if pie in tags and (inner is None or inner not in tags) and (outer is None or outer in tags):
+                    region_of[dt] = reg.layer
+                    break
         groups = list(LAYERS) + sorted({reg.layer for reg in plaque})
         by_layer = {name: [] for name in groups}
         core = []
@@ -260,8 +295,14 @@ def build_artery(
                 by_layer[region_of[dt]].append(dt[1])
             else:
                 by_layer[LAYERS[3 - k]].append(dt[1])
-        if set(region_of) - set(count):
-            raise RuntimeError("a plaque region reaches outside the wall")
+        outside = sorted(set(inside) - set(count))
+        if outside:  # a tool reaching beyond the outer wall: a bug of the tools' radii, not an input error
+            c = occ.getCenterOfMass(*outside[0])
+            vol = sum(occ.getMass(*dt) for dt in outside)
+            raise RuntimeError(
+                f"a plaque region reaches outside the wall near ({', '.join(f'{x:.2f}' for x in c)}) mm "
+                f"({len(outside)} pieces, {vol:.3g} mm^3)"
+            )
         if any(not v for v in by_layer.values()) or not core:
             empty = [name for name, v in by_layer.items() if not v]
             raise RuntimeError(f"gmsh fragment did not give three nested layers and the plaque (empty: {empty})")
