@@ -45,7 +45,7 @@ def plaque_types():
         return yaml.safe_load(f)
 
 
-def _arcs_overlap(a, b):
+def arcs_overlap(a, b):
     """Do the angular intervals a = [a0, a1] and b (degrees) share more than a boundary?"""
     if a[1] - a[0] >= 360.0 or b[1] - b[0] >= 360.0:
         return True
@@ -94,7 +94,7 @@ def read_plaque(entries, length, scene_path):
         )
         for j, o in enumerate(regions[:-1]):
             r = regions[-1]
-            if r.from_s < o.to_s and o.from_s < r.to_s and _arcs_overlap(r.angle, o.angle) and _depths_overlap(r, o):
+            if r.from_s < o.to_s and o.from_s < r.to_s and arcs_overlap(r.angle, o.angle) and _depths_overlap(r, o):
                 raise PatientInputError(
                     f"{scene_path}: {key}: expected regions that do not overlap, got one that overlaps "
                     f"patient.plaque[{j}] (s {o.from_s:g} to {o.to_s:g} mm, angle {list(o.angle)})"

@@ -27,9 +27,13 @@ def read_labels(surface_path, surface, name):
     return values.astype(int)
 
 
-def regions_from_labels(labels, s, types, thickness, where):
-    """patient.plaque entries ({type, from_s, to_s, angle[, thickness]}) of the label grid `labels`
-    (n stations at arc lengths s, K rays at 360 k / K degrees); `types` the names of labels 1, 2, ..."""
+def regions_from_labels(labels, s, types, thickness, where, depth=None, intima=None):
+    """patient.plaque entries ({type, from_s, to_s, angle[, offset, thickness]}) of the label grid
+    `labels` (n stations at arc lengths s, K rays at 360 k / K degrees); `types` the names of labels
+    1, 2, ... With `depth` (n, K, 2: each sample's labelled depth range below the lumen, mm) and the
+    intima's thickness (n, K), each region's offset and thickness bound its samples' ranges (to the
+    intima's outer surface, no thickness, where a range reaches within 2 % of it); else every region
+    starts at the lumen and has `thickness`."""
     labels = np.asarray(labels)
     n, K = labels.shape
     if labels.max() > len(types):
@@ -68,7 +72,13 @@ def regions_from_labels(labels, s, types, thickness, where):
             angle = [a0, a0 + span * step]
         e = {"type": types[labels.ravel()[cells[0]] - 1], "from_s": float(from_s), "to_s": float(to_s)}
         e["angle"] = [float(x) for x in angle]
-        if thickness is not None:
+        if depth is not None:
+            lo, hi = depth[i, k, 0].min(), depth[i, k, 1].max()
+            if lo > 0.0:
+                e["offset"] = float(lo)
+            if hi < 0.98 * intima[i, k].min():
+                e["thickness"] = float(hi - lo)
+        elif thickness is not None:
             e["thickness"] = float(thickness)
         entries.append(e)
     return entries

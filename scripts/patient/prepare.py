@@ -32,6 +32,7 @@ from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 from .plaque import check_within_intima, plaque_materials, read_plaque
 from .plaque_labels import read_labels, regions_from_labels
+from .plaque_volume import regions_from_mesh
 
 # The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
 # and checked by scene_keys.check_map.
@@ -295,6 +296,14 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     )
     if from_labels:
         log(f"patient: {len(from_labels)} plaque regions from the surface's labels")
+    if pat["plaque_mesh"]:
+        key = "patient.plaque_mesh"
+        pm = scene_keys.check_map(pat["plaque_mesh"], key, scene_path, PatientInputError)
+        pm["file"] = str((scene_path.parent / pm["file"]).resolve())
+        intima = layer_radii(r_lumen, w_lumen, spec, str(csv_path))[1]
+        from_mesh = regions_from_mesh(pm, cl, r_lumen, intima, f"{scene_path}: {key}")
+        log(f"patient: {len(from_mesh)} plaque regions from the labels of {Path(pm['file']).name}")
+        from_labels = from_labels + from_mesh
     plaque = read_plaque((pat["plaque"] or []) + from_labels, float(cl.arc_length[-1]), scene_path)
     if plaque:
         check_within_intima(plaque, cl.arc_length, layer_radii(r_lumen, w_lumen, spec, str(csv_path))[1], scene_path)
@@ -392,6 +401,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
                 "from_s": r.from_s,
                 "to_s": r.to_s,
                 "angle": list(r.angle),
+                "offset": r.offset,
                 "thickness": r.thickness if r.thickness is not None else "intima",
                 "material": done["artery"]["layers"][r.layer],
             }

@@ -116,6 +116,57 @@ class Plaque(unittest.TestCase):
         self.assertEqual(self.done["artery"]["layers"]["plaque_calcified"]["E"], plaque_types()["calcified"]["E"])
         self.assertGreater(self.report["artery_mesh"]["min_scaled_jacobian"], 0.0)
 
+    def test_regions_from_a_label_mesh(self):
+        """patient.plaque_mesh: the fixture's own tet10 mesh written as VTU with a cell label per
+        element (1 calcified, 2 fibrous, 3 lipid, 0 the rest) gives back the declared regions: the
+        sectors within a centerline station and a ray (7.5 deg), offset and thickness within two of
+        the 16 depth samples through the intima."""
+        import meshio
+
+        m = meshio.read(os.path.join(self.out, "artery.msh"))
+        names = {tag: name for name, (tag, dim) in m.field_data.items() if dim == 3}
+        types = ["calcified", "fibrous", "lipid"]
+        cells, labels = [], []
+        for block, phys in zip(m.cells, m.cell_data["gmsh:physical"]):
+            if block.type == "tetra10":
+                name = names[phys[0]]
+                cells.append(block.data)
+                labels.append(np.full(len(block.data), types.index(name[7:]) + 1 if name.startswith("plaque_") else 0))
+        path = os.path.join(self.tmp, "labels.vtu")
+        cell_data = {"label": [np.concatenate(labels)]}
+        meshio.write(path, meshio.Mesh(m.points, [("tetra10", np.concatenate(cells))], cell_data=cell_data))
+        sc = scene([])
+        sc["patient"]["plaque_mesh"] = {"file": path, "array": "label", "types": types}
+        out = os.path.join(self.tmp, "from_mesh")
+        os.makedirs(out)
+        _, report = prepare_scene(sc, self.scene_path, out, log=lambda m: None)
+        got = {r["layer"]: r for r in report["plaque"]}
+        for r in report["plaque"]:
+            print(r["layer"], {k: r[k] for k in ("from_s", "to_s", "angle", "offset", "thickness")})
+        self.assertEqual(set(got), {"plaque_calcified", "plaque_fibrous", "plaque_lipid"}, report["plaque"])
+        z = np.linspace(0.0, LENGTH, 6501)
+        _, ti, _, _ = layer_radii(lumen_radius(z), np.full(len(z), WALL), WallSpec(0.06, 0.065, 0.05), "test")
+        sample = 2 * ti.max() / 16
+        station = LENGTH / 52
+        for reg in (CALCIFIED, CAP, POOL):
+            r = got[f"plaque_{reg['type']}"]
+            for k in ("from_s", "to_s"):
+                self.assertAlmostEqual(r[k], reg[k], delta=station, msg=f"{reg['type']} {k}: {r[k]:.3f}")
+            for a, b in zip(r["angle"], reg["angle"]):
+                self.assertAlmostEqual(a, b, delta=7.5, msg=f"{reg['type']} angle: {r['angle']}")
+            self.assertAlmostEqual(r["offset"], reg.get("offset", 0.0), delta=sample, msg=f"{reg['type']}: {r}")
+            if "thickness" in reg:
+                self.assertAlmostEqual(r["thickness"], reg["thickness"], delta=sample, msg=f"{reg['type']}: {r}")
+            else:
+                self.assertEqual(r["thickness"], "intima", f"{reg['type']}: {r}")
+        # a label without a type name, an absent array: refused naming the file and the key
+        sc["patient"]["plaque_mesh"]["types"] = types[:2]
+        with self.assertRaisesRegex(PatientInputError, "plaque_mesh.types: expected a name for every label"):
+            prepare_scene(sc, self.scene_path, out, log=lambda m: None)
+        sc["patient"]["plaque_mesh"].update(types=types, array="tissue")
+        with self.assertRaisesRegex(PatientInputError, "labels.vtu: expected a cell data array 'tissue'.*label"):
+            prepare_scene(sc, self.scene_path, out, log=lambda m: None)
+
     def test_scene_material_wins(self):
         regions = read_plaque([CALCIFIED, CAP, POOL], LENGTH, "s.yaml")
         own = {"plaque_calcified": {"E": 5.0, "nu": 0.4}}
