@@ -145,7 +145,10 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
     two separately lofted copies of them, which OpenCASCADE's fragment cannot merge on a curved
     centerline (overlapping facets, pieces outside the wall). The pie reaches halfway from the deepest
     bound to the intima's outer surface, or halfway into the media when a region reaches the intima's
-    outer surface (thickness None), so that its rim coincides with no other surface.
+    outer surface (thickness None), so that its rim coincides with no other surface. A region alone
+    over its sector and at the lumen needs no depth loft: its pie's rim is its depth (a depth loft
+    is closed around the vessel and would split the intima where it is thin, e.g. opposite an
+    eccentric plaque, into slivers gmsh cannot mesh).
     Returns (solids: list of dimtag lists, of_region: [(pie, inner or None, outer or None)] indices)."""
     solids, pie_of, depth_of, of_region = [], {}, {}, []
 
@@ -161,10 +164,17 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
         deepest = max((r.offset + r.thickness for r in same if r.thickness is not None), default=0.0)
         to_media = any(r.thickness is None for r in same)
 
-        def rim(lumen, i_out, m_out, reg, deepest=deepest, to_media=to_media):
-            return 0.5 * (i_out + m_out) if to_media else 0.5 * (lumen + deepest + i_out)
+        alone = len(same) == 1 and reg.offset == 0.0
+
+        def rim(lumen, i_out, m_out, reg, deepest=deepest, to_media=to_media, alone=alone):
+            if to_media:
+                return 0.5 * (i_out + m_out)
+            return lumen + deepest if alone else 0.5 * (lumen + deepest + i_out)
 
         pie = tool(sector, pie_of, lambda: _sector_loft(occ, reg, s, P, t, n1, radii, rim))
+        if alone:  # the pie's rim is the region's depth: no depth lofts (they would cut the whole ring)
+            of_region.append((pie, None, None))
+            continue
         bounds = []
         for d in (
             reg.offset if reg.offset > 0.0 else None,
