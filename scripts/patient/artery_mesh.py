@@ -166,7 +166,7 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
 
         alone = len(same) == 1 and reg.offset == 0.0
 
-        def rim(lumen, i_out, m_out, reg, deepest=deepest, to_media=to_media, alone=alone):
+        def rim(lumen, i_out, m_out, deepest=deepest, to_media=to_media, alone=alone):
             if to_media:
                 return 0.5 * (i_out + m_out)
             return lumen + deepest if alone else 0.5 * (lumen + deepest + i_out)
@@ -189,7 +189,7 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
                     (reg.from_s, reg.to_s, d),
                     depth_of,
                     lambda d=d, whole=whole: _sector_loft(
-                        occ, whole, s, P, t, n1, radii, lambda lumen, i_out, m_out, reg: lumen + d
+                        occ, whole, s, P, t, n1, radii, lambda lumen, i_out, m_out: lumen + d
                     ),
                 )
             )
@@ -199,7 +199,7 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
 
 def _sector_loft(occ, reg, s, P, t, n1, radii, radius_of):
     """The loft through the region's sections of radius radius_of(lumen, intima's outer, media's
-    outer radius, region) per section: closed curves for a full circle, else pie slices."""
+    outer radius) per section: closed curves for a full circle, else pie slices."""
     ss = np.concatenate([[reg.from_s], s[(s > reg.from_s + 1e-6) & (s < reg.to_s - 1e-6)], [reg.to_s]])
     Pk = np.column_stack([np.interp(ss, s, P[:, c]) for c in range(3)])
     tk = np.column_stack([np.interp(ss, s, t[:, c]) for c in range(3)])
@@ -208,7 +208,7 @@ def _sector_loft(occ, reg, s, P, t, n1, radii, radius_of):
     nk -= np.einsum("ij,ij->i", nk, tk)[:, None] * tk
     nk /= np.linalg.norm(nk, axis=1)[:, None]
     bk = np.cross(tk, nk)
-    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(3)), reg)
+    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(3)))
     a0, a1 = (math.radians(a) for a in reg.angle)
     wires = []
     for i in range(len(ss)):
@@ -360,13 +360,13 @@ def build_artery(
                 gmsh.model.mesh.optimize("HighOrder")
             except Exception as e:  # gmsh raises a bare Exception when it cannot reach its target
                 log(f"patient: gmsh's high-order optimization stopped ({' '.join(str(e).split())})")
-        straightened = _straighten_inverted()
+        straightened, still_inverted = _straighten_inverted()
         if straightened:
             log(
                 f"patient: {straightened} tet10 straightened (mid-edge nodes at the edge midpoints) to keep "
                 f"every Jacobian positive"
             )
-        if not _min_quadratic_jacobian() > 0.0:
+        if still_inverted:
             raise RuntimeError("gmsh produced an inverted tetrahedron")
         quality, where_bad = _min_scaled_jacobian()
         if not quality > 0.0:  # positive at the samples but the corners' tetrahedron inverted: tangled
@@ -472,17 +472,17 @@ TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
 def _straighten_inverted(max_rounds=5):
     """Moves the mid-edge nodes of tet10 with a non-positive Jacobian (at any sample of
     _jacobian_samples) to their edge midpoints (a straight-sided tet10 is valid whenever its tet4
-    is); returns how many elements were changed."""
+    is); returns (how many elements were changed, how many are still inverted after max_rounds)."""
     import gmsh
 
     changed = set()
-    for _ in range(max_rounds):
+    for round_ in range(max_rounds + 1):
         tags, nodes, dets, _, corner = _jacobian_samples()
         bad = np.nonzero(dets.min(axis=1) <= 0.0)[0]
-        if not len(bad):
+        if not len(bad) or round_ == max_rounds:
             break
         for e in bad:
             changed.add(int(tags[e]))
             for k, (a, b) in enumerate(TET10_EDGES):
                 gmsh.model.mesh.setNode(int(nodes[e, 4 + k]), list(0.5 * (corner[e, a] + corner[e, b])), [])
-    return len(changed)
+    return len(changed), len(bad)

@@ -27,12 +27,18 @@ def read_labels(surface_path, surface, name):
     return values.astype(int)
 
 
+def check_types(types, where):
+    """The label names of a labelled plaque input (`where`: its key): a non-empty list of names."""
+    if not types or not isinstance(types, list) or not all(isinstance(x, str) for x in types):
+        raise PatientInputError(f"{where}.types: expected a list of plaque type names, got {types!r}")
+
+
 def regions_from_labels(labels, s, types, thickness, where, depth=None, intima=None):
     """patient.plaque entries ({type, from_s, to_s, angle[, offset, thickness]}) of the label grid
     `labels` (n stations at arc lengths s, K rays at 360 k / K degrees); `types` the names of labels
     1, 2, ... With `depth` (n, K, 2: each sample's labelled depth range below the lumen, mm) and the
     intima's thickness (n, K), each region's offset and thickness bound its samples' ranges (to the
-    intima's outer surface, no thickness, where a range reaches within 2 % of it); else every region
+    intima's outer surface, no thickness, where a sample's range reaches that ray's); else every region
     starts at the lumen and has `thickness`."""
     labels = np.asarray(labels)
     n, K = labels.shape
@@ -76,7 +82,7 @@ def regions_from_labels(labels, s, types, thickness, where, depth=None, intima=N
             lo, hi = depth[i, k, 0].min(), depth[i, k, 1].max()
             if lo > 0.0:
                 e["offset"] = float(lo)
-            if hi < 0.98 * intima[i, k].min():
+            if not np.any(depth[i, k, 1] >= intima[i, k] * (1.0 - 1e-9)):  # reaching it on no ray
                 e["thickness"] = float(hi - lo)
         elif thickness is not None:
             e["thickness"] = float(thickness)

@@ -110,10 +110,9 @@ def regions_from_mesh(spec, cl, r_lumen, intima, where):
     centerline cl: the lumen radius r_lumen and the intima's thickness per station, (n,) or (n, K)."""
     from .artery_mesh import section_frames
     from .lumen_sections import ANGLES
-    from .plaque_labels import regions_from_labels
+    from .plaque_labels import check_types, regions_from_labels
 
-    if not spec["types"] or not all(isinstance(x, str) for x in spec["types"]):
-        raise PatientInputError(f"{where}.types: expected a list of plaque type names, got {spec['types']!r}")
+    check_types(spec["types"], where)
     grid = read_label_mesh(spec["file"], spec["array"], spec["units"])
 
     def rays(a):
@@ -125,11 +124,6 @@ def regions_from_mesh(spec, cl, r_lumen, intima, where):
         raise ValueError(f"{rho.shape[1]} rays, expected {ANGLES}")
     _, n1, n2 = section_frames(cl.points)
     found = sample_labels(grid, cl.points, n1, n2, rho, ti)
-    if found and max(found) > len(spec["types"]):
-        raise PatientInputError(
-            f"{where}.types: expected a name for every label, got {len(spec['types'])} names for labels up to "
-            f"{max(found)}"
-        )
     regions = [
         e
         for lab, (hit, depth) in sorted(found.items())

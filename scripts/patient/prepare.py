@@ -31,7 +31,7 @@ from .lumen_sections import LumenSections, inscribed_radius, read_wall_field
 from .lumen_surface import read_lumen_surface
 from .placement import Device, devices_fit, place_device, stenosis_site
 from .plaque import check_within_intima, plaque_materials, read_plaque
-from .plaque_labels import read_labels, regions_from_labels
+from .plaque_labels import check_types, read_labels, regions_from_labels
 from .plaque_volume import regions_from_mesh
 
 # The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
@@ -200,10 +200,7 @@ def lumen_csv(pat, scene_path, out_dir, log):
         return out, None, None
     labels = None
     if plaque:
-        if not plaque["types"] or not all(isinstance(x, str) for x in plaque["types"]):
-            raise PatientInputError(
-                f"{scene_path}: {key}.types: expected a list of plaque type names, got {plaque['types']!r}"
-            )
+        check_types(plaque["types"], f"{scene_path}: {key}")
         labels = read_labels(str(path), surface, plaque["array"])
     wall = {}
     if thickness == "from_surface":
@@ -294,19 +291,19 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     spec = WallSpec(
         media_ratio=wall["media_ratio"], adventitia_ratio=wall["adventitia_ratio"], min_intima=wall["min_intima"]
     )
+    _, intima, _, _ = layer_radii(r_lumen, w_lumen, spec, str(csv_path))  # per station, or station and ray
     if from_labels:
         log(f"patient: {len(from_labels)} plaque regions from the surface's labels")
     if pat["plaque_mesh"]:
         key = "patient.plaque_mesh"
         pm = scene_keys.check_map(pat["plaque_mesh"], key, scene_path, PatientInputError)
         pm["file"] = str((scene_path.parent / pm["file"]).resolve())
-        intima = layer_radii(r_lumen, w_lumen, spec, str(csv_path))[1]
         from_mesh = regions_from_mesh(pm, cl, r_lumen, intima, f"{scene_path}: {key}")
         log(f"patient: {len(from_mesh)} plaque regions from the labels of {Path(pm['file']).name}")
         from_labels = from_labels + from_mesh
     plaque = read_plaque((pat["plaque"] or []) + from_labels, float(cl.arc_length[-1]), scene_path)
     if plaque:
-        check_within_intima(plaque, cl.arc_length, layer_radii(r_lumen, w_lumen, spec, str(csv_path))[1], scene_path)
+        check_within_intima(plaque, cl.arc_length, intima, scene_path)
     layers = artery.get("layers")
     if not isinstance(layers, dict):
         raise PatientInputError(
@@ -333,9 +330,8 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         # the tool stretches the innermost layer most: elements larger than it is thick invert there
         # (measured on the CI lesion, a 0.94 mm lumen in a 1.0 mm wall with a 0.63 mm intima: mesh.size
         # 1.0 stops where the artery contacts switch on, 0.5 runs)
-        _, ti, _, _ = layer_radii(r_lumen, w_lumen, spec, str(csv_path))
         k = int(np.argmin(np.abs(cl.arc_length - s_site)))
-        ti = ti if ti.ndim == 1 else ti.min(axis=1)
+        ti = intima if intima.ndim == 1 else intima.min(axis=1)
         if mesh["size"] > ti[k]:
             log(
                 f"patient: warning: patient.mesh.size {mesh['size']:g} mm is larger than the intima at the lesion "
