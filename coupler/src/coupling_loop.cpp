@@ -33,7 +33,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
   const auto run_start = Clock::now();
   const std::size_t n = beam.sample_points().size();
   const double sqrt_len = std::sqrt(static_cast<double>(3 * n));
-  auto scheme = make_interface_scheme(settings.scheme, n);
+  auto scheme = make_interface_scheme(settings.scheme, n, settings.surface_compliance);
 
   double first_residual_force = 0.0;  // |w r_0| of the last accepted step (N): iteration 0's solid tolerance
   if (settings.synchronize) {

@@ -14,6 +14,9 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   if (!c) return s;
   c->check_keys();
   s.scheme = c->get<std::string>("scheme");
+  s.surface_compliance = c->get<bool>("surface_compliance");
+  if (s.surface_compliance && s.scheme != "robin")
+    c->child("surface_compliance").fail("false (it applies only with coupling.scheme: robin)");
   s.acceleration = c->get<std::string>("acceleration");
   s.initial_relaxation = c->get<double>("initial_relaxation");
   s.max_relaxation = c->has("max_relaxation") ? c->get<double>("max_relaxation") : std::max(1.0, s.initial_relaxation);
@@ -47,6 +50,7 @@ CouplingSettings coupling_settings(const scene::Node& root) {
 
 std::string settings_json(const CouplingSettings& s) {
   nlohmann::ordered_json j = {{"scheme", s.scheme},
+                              {"surface_compliance", s.surface_compliance},
                               {"acceleration", s.acceleration},
                               {"initial_relaxation", s.initial_relaxation},
                               {"max_relaxation", s.max_relaxation},

@@ -1,5 +1,7 @@
 #include "angio/coupler/robin.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -10,7 +12,7 @@
 
 namespace angio::coupler {
 
-Robin::Robin(std::size_t n) : n_(n) {
+Robin::Robin(std::size_t n, bool surface_compliance) : n_(n), compliance_(surface_compliance) {
   set_planes_per_point_(1);
   c_ = c_tilde_ = c_last_ = Eigen::VectorXd::Zero(3 * n);
 }
@@ -19,12 +21,14 @@ void Robin::set_planes_per_point_(std::size_t K) {
   K_ = K;
   p_.s = p_.n = Eigen::VectorXd::Zero(3 * K * n_);
   p_.eps = Eigen::VectorXd::Zero(K * n_);  // no planes before the solid has answered once
-  p_tilde_ = p_last_ = p_before_ = p_;
+  p_tilde_ = p_last_ = p_before_ = reply_ = first_ = p_;
+  k_ = f_first_ = f_reply_ = Eigen::VectorXd::Zero(K * n_);
 }
 
 void Robin::begin_step(double increment, bool extrapolate) {
   p_ = p_last_;
   c_ = c_last_;
+  have_first_ = false;
   if (!(extrapolate && dt_last_ > 0.0)) return;
   const double f = increment / dt_last_;
   for (Eigen::Index i = 0; i < p_.eps.size(); ++i)
@@ -43,6 +47,58 @@ participant::SolveStats Robin::solve_beam(participant::BeamParticipant& beam) {
   planes.eps.assign(p_.eps.data(), p_.eps.data() + p_.eps.size());
   planes.g0 = p_.g0;
   return beam.solve_with_planes(unflatten(c_), planes);
+}
+
+Eigen::VectorXd Robin::plane_forces_(const participant::SamplePoints& x, const Planes& p) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(p.eps.size());
+  for (Eigen::Index j = 0; j < p.eps.size(); ++j) {
+    if (!(p.eps[j] > 0.0)) continue;
+    const std::size_t i = std::size_t(j) / K_;
+    const Eigen::Vector3d xi(x.x[i][0], x.x[i][1], x.x[i][2]);
+    const Eigen::Vector3d n = p.n.segment<3>(3 * j);
+    f[j] = participant::plane_penalty(xi, p.s.segment<3>(3 * j), n, p.eps[j], x.radius[i], p.g0).q.dot(n);
+  }
+  return f;
+}
+
+Robin::Planes Robin::softened_(const participant::SamplePoints& x, const Planes& p, const Eigen::VectorXd& f) const {
+  Planes b = p;
+  for (Eigen::Index j = 0; j < p.eps.size(); ++j) {
+    const double eps = p.eps[j], k = k_[j];
+    if (!(eps > 0.0) || !(k > 0.0)) continue;
+    // the series spring of penalty and surface, placed where the unloaded surface would be: it
+    // carries the plane's load f_j at x (penalty_gap inverts the law for the new penalty)
+    b.eps[j] = eps * k / (eps + k);
+    if (!(f[j] > 0.0)) continue;
+    const std::size_t i = std::size_t(j) / K_;
+    const Eigen::Vector3d n = p.n.segment<3>(3 * j);
+    const Eigen::Vector3d xi(x.x[i][0], x.x[i][1], x.x[i][2]);
+    const double g = (xi - p.s.segment<3>(3 * j)).dot(n) - x.radius[i];
+    b.s.segment<3>(3 * j) += (g - participant::penalty_gap(f[j], p.g0, b.eps[j])) * n;
+  }
+  return b;
+}
+
+void Robin::update_stiffness_() {
+  // Secant of each plane's force against its offset over this step's coupling iterations (fixed
+  // external loads: what moved the surface is the contact). Only where the force changed by more
+  // than 10 % of itself and the surface gave way against it; kept within 1e-3..1e3 of the penalty
+  // (a plane dragged along by its neighbours' loads has a meaningless secant).
+  for (Eigen::Index j = 0; j < k_.size(); ++j) {
+    const double eps = reply_.eps[j];
+    if (!(eps > 0.0)) {
+      k_[j] = 0.0;  // no surface in range: the estimate belonged to another contact
+      continue;
+    }
+    // in contact at both ends of the secant: a point that just touched moved with its neighbours
+    if (!(first_.eps[j] > 0.0) || !(f_first_[j] > 0.0) || !(f_reply_[j] > 0.0)) continue;
+    const Eigen::Vector3d n = reply_.n.segment<3>(3 * j);
+    const double dd = n.dot(reply_.s.segment<3>(3 * j) - first_.s.segment<3>(3 * j));
+    const double df = f_reply_[j] - f_first_[j];
+    if (!(std::abs(df) > 0.1 * std::max(f_reply_[j], f_first_[j])) || !(df * dd < 0.0)) continue;
+    const double k = std::clamp(-df / dd, 1e-3 * eps, 1e3 * eps);
+    k_[j] = k_[j] > 0.0 ? std::sqrt(k_[j] * k) : k;  // geometric mean with the last estimate: less noise
+  }
 }
 
 Eigen::VectorXd Robin::plane_loads(const participant::SamplePoints& x, const Planes& p) {
@@ -72,10 +128,21 @@ Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const 
   }
   const Eigen::VectorXd q_tilde = flatten(reply.line_loads);
   const Eigen::VectorXd q_beam = c_ + plane_loads(x, p_);  // what the beam applied at x
-  p_tilde_.s = flatten(reply.surface_points);
-  p_tilde_.n = flatten(reply.normals);
-  p_tilde_.g0 = reply.regularization;
-  p_tilde_.eps = Eigen::Map<const Eigen::VectorXd>(reply.penalty.data(), Eigen::Index(reply.penalty.size()));
+  reply_.s = flatten(reply.surface_points);
+  reply_.n = flatten(reply.normals);
+  reply_.g0 = reply.regularization;
+  reply_.eps = Eigen::Map<const Eigen::VectorXd>(reply.penalty.data(), Eigen::Index(reply.penalty.size()));
+  p_tilde_ = reply_;
+  if (compliance_) {
+    x_ = x;
+    f_reply_ = plane_forces_(x, reply_);
+    if (!have_first_) {
+      first_ = reply_;
+      f_first_ = f_reply_;
+      have_first_ = true;
+    }
+    p_tilde_ = softened_(x, reply_, f_reply_);
+  }
   c_tilde_ = q_tilde - plane_loads(x, p_tilde_);
   return q_tilde - q_beam;
 }
@@ -102,6 +169,11 @@ void Robin::next_iterate(Acceleration& acc, int k) {
 }
 
 void Robin::accept(double increment) {
+  if (compliance_) {
+    // the new estimates apply from the accepted state on (the next step's first iterate)
+    update_stiffness_();
+    p_tilde_ = softened_(x_, reply_, f_reply_);
+  }
   p_before_ = p_last_;
   p_last_ = p_tilde_;
   c_last_ = c_tilde_;

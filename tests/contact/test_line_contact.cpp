@@ -323,3 +323,18 @@ TEST(PenaltyLaw, DerivativesAndContinuity) {
   EXPECT_DOUBLE_EQ(end.pi, 0.0);
   EXPECT_DOUBLE_EQ(penalty_law(-0.01, 0.0, eps).f, 0.1);  // linear law: ε |g|
 }
+
+// penalty_gap inverts penalty_law on both branches (round trip g -> f -> g) and returns the edge of
+// contact for no force.
+TEST(PenaltyLaw, GapOfAForceInvertsTheLaw) {
+  using angio::participant::penalty_gap;
+  using angio::participant::penalty_law;
+  for (double eps : {0.3, 10.0})
+    for (double g0 : {0.0, 0.005})
+      for (double g : {-0.02, -0.003, -1e-5, 0.001, 0.0049}) {
+        if (!(g < g0)) continue;
+        EXPECT_NEAR(penalty_gap(penalty_law(g, g0, eps).f, g0, eps), g, 1e-12) << "eps " << eps << " g0 " << g0;
+      }
+  EXPECT_EQ(penalty_gap(0.0, 0.005, 10.0), 0.005);
+  EXPECT_EQ(penalty_gap(0.0, 0.0, 10.0), 0.0);
+}

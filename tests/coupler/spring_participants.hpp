@@ -108,4 +108,35 @@ struct WallSolid : participant::SolidParticipant {
   void finish() override {}
 };
 
+// The wall of WallSolid on springs: point i's surface gives way by q_i / kw_i (kw per unit length,
+// one per point), so the contact is the series spring of the penalty and the surface,
+// eps' = eps kw / (eps + kw): q~_i = eps' max(s − x_i − R, 0), and the coupled fixed point is
+// q*_i = eps'_i (s − x0 − R) / (1 + eps'_i / kb). The planes it reports sit on the displaced surface.
+struct SoftWallSolid : WallSolid {
+  std::vector<double> kw;
+  double q_star(int i, double kb, double R) const {
+    const double e = eps * kw[i] / (eps + kw[i]);
+    return e * (s_max - x0 - R) / (1.0 + e / kb);
+  }
+  participant::SolveStats solve(const participant::SamplePoints& p, participant::ContactReply& reply,
+                                double tolerance) override {
+    tolerances.push_back(tolerance);
+    reply = {};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double e = eps * kw[i] / (eps + kw[i]);
+      const double q = e * std::max(s - p.x[i][0] - p.radius[i], 0.0);
+      const double surface = s - q / kw[i];
+      reply.line_loads.push_back({q, 0.0, 0.0});
+      reply.surface_points.push_back({surface - 2.0 * p.radius[i], p.x[i][1], p.x[i][2]});
+      reply.normals.push_back({1.0, 0.0, 0.0});
+      reply.penalty.push_back(eps);
+      reply.total_force[0] += p.w[i] * q;
+      if (q > 0) ++reply.n_active;
+    }
+    participant::SolveStats st;
+    st.converged = true;
+    return st;
+  }
+};
+
 }  // namespace angio::test

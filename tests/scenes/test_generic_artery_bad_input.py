@@ -43,6 +43,11 @@ CASES = [
     # tolerances that accept a step before it moves (the Newton ladder's atol 1 N ended "ok" uninflated)
     ("solid atol of the order of the load", lambda s: s["solid"]["newton"].update(atol=1.0), "solid.newton.atol"),
     ("coupling rel_tol 1", lambda s: s["coupling"].update(rel_tol=1.0), "coupling.rel_tol"),
+    (
+        "surface compliance without robin planes",
+        lambda s: s["coupling"].update(scheme="dirichlet-neumann", surface_compliance=True),
+        "coupling.surface_compliance",
+    ),
     # absurd values inside the type's range: a pressure in Pa or kPa taken for MPa
     ("balloon pressure 1e6 MPa", lambda s: s["balloon"]["pressure"].update(value=1.0e6), "balloon.pressure"),
     (

@@ -13,6 +13,7 @@ namespace angio::coupler {
 
 struct CouplingSettings {
   std::string scheme = scene::keys::defaults::coupling_scheme;
+  bool surface_compliance = scene::keys::defaults::coupling_surface_compliance;  // robin only
   std::string acceleration = scene::keys::defaults::coupling_acceleration;
   double initial_relaxation = scene::keys::defaults::coupling_initial_relaxation;
   double max_relaxation = 1.0;  // max(1, initial_relaxation) when not given

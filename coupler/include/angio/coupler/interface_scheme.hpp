@@ -43,6 +43,7 @@ class InterfaceScheme {
   }
 };
 
-std::unique_ptr<InterfaceScheme> make_interface_scheme(const std::string& name, std::size_t n_points);
+std::unique_ptr<InterfaceScheme> make_interface_scheme(const std::string& name, std::size_t n_points,
+                                                      bool surface_compliance = false);
 
 }  // namespace angio::coupler

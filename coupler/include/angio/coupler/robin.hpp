@@ -9,6 +9,19 @@
 // and the iteration oscillates as in plain Dirichlet–Neumann). The remainder q~ − Σ q_plane(x) of
 // the solid's load (zero when the planes represent the contact exactly) is passed to the beam as a
 // fixed line load, so the fixed point is exact in any case.
+//
+// Surface compliance (optional): a plane with penalty ε in front of a soft surface (the artery wall,
+// a pressurized balloon) tells the beam that the contact is as stiff as the penalty, while the
+// surface gives way behind it. A strut pressed between two soft surfaces then moves by only about
+// (k_a + k_b)/(2ε) of its error per iteration (k the surfaces' stiffness per unit length, ~0.1
+// N/mm² for the wall against ε = 10): the struts creep into the wall over many iterations. With
+// `surface_compliance` each plane j carries an estimate k_j of its surface's stiffness against its
+// own load (the secant −Δf_j/Δd_j of its force and its offset along the normal between the first
+// and the last coupling iteration of an accepted step, smoothed over steps), and the iterate is the
+// series spring of penalty and surface, ε' = ε k/(ε + k), at the unloaded surface (the reply's plane
+// moved along n so that at the beam's positions it carries the reply's load). The beam then sees
+// the interface's tangent in this diagonal model; the map stays a function of the iterate (IQN's
+// secants hold) and at the fixed point both laws carry the solid's load.
 #pragma once
 
 #include "angio/coupler/interface_scheme.hpp"
@@ -17,7 +30,7 @@ namespace angio::coupler {
 
 class Robin : public InterfaceScheme {
  public:
-  explicit Robin(std::size_t n_points);
+  explicit Robin(std::size_t n_points, bool surface_compliance = false);
   void begin_step(double increment, bool extrapolate) override;
   participant::SolveStats solve_beam(participant::BeamParticipant& beam) override;
   Eigen::VectorXd force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) override;
@@ -34,7 +47,21 @@ class Robin : public InterfaceScheme {
   std::size_t n_ = 0, K_ = 1;
   // Σ line loads of the planes at positions x (N/mm, 3 per point).
   static Eigen::VectorXd plane_loads(const participant::SamplePoints& x, const Planes& p);
-  Planes p_, p_tilde_, p_last_, p_before_;
+  // Forces (N/mm, along n) of the planes p at positions x.
+  Eigen::VectorXd plane_forces_(const participant::SamplePoints& x, const Planes& p) const;
+  // With surface compliance: the planes p (forces f at x) as series springs of penalty and surface
+  // at the unloaded surface; planes without an estimate stay as they are.
+  Planes softened_(const participant::SamplePoints& x, const Planes& p, const Eigen::VectorXd& f) const;
+  // Surface stiffness per plane from this step's first and last replies (secant), at accept.
+  void update_stiffness_();
+  // p_tilde_: the last reply as an iterate (softened with surface compliance), reply_: as the solid
+  // sent it; first_: the step's first reply (for the secant).
+  Planes p_, p_tilde_, p_last_, p_before_, reply_, first_;
+  bool compliance_ = false;
+  Eigen::VectorXd k_;                  // per plane: surface stiffness estimate (N/mm²), 0 unknown
+  Eigen::VectorXd f_first_, f_reply_;  // plane forces of first_ and reply_
+  participant::SamplePoints x_;        // positions of the last reply
+  bool have_first_ = false;
   Eigen::VectorXd c_, c_tilde_, c_last_;  // remainder loads (two surfaces at one point)
   double dt_last_ = 0.0;
 };
