@@ -8,7 +8,7 @@
 namespace angio::coupler {
 
 std::unique_ptr<InterfaceScheme> make_interface_scheme(const std::string& name, std::size_t n_points,
-                                                      bool surface_compliance) {
+                                                       bool surface_compliance) {
   if (name == "robin") return std::make_unique<Robin>(n_points, surface_compliance);
   if (name == "dirichlet-neumann") return std::make_unique<DirichletNeumann>(n_points);
   throw std::invalid_argument("unknown coupling scheme '" + name + "' (dirichlet-neumann | robin)");

@@ -170,8 +170,8 @@ TEST(CouplingLoop, RobinSurfaceComplianceKeepsTheFixedPointAndSavesIterations) {
     coupler::IqnIlsOptions o;
     o.reused_steps = 0;
     coupler::IqnIls iqn(o);
-    const coupler::RunReport r = coupler::run_coupled(
-        beam, wall, ramp(8), s, iqn, [&](const coupler::StepReport& rep) { reports.push_back(rep); });
+    const coupler::RunReport r = coupler::run_coupled(beam, wall, ramp(8), s, iqn,
+                                                      [&](const coupler::StepReport& rep) { reports.push_back(rep); });
     EXPECT_EQ(r.steps, 8);
     for (int i = 0; i < beam.n; ++i)
       EXPECT_NEAR(beam.x_committed[i], beam.x0 + wall.q_star(i, beam.kb, beam.R) / beam.kb, 1e-7) << "point " << i;
