@@ -91,7 +91,7 @@ void Robin::update_stiffness_() {
       continue;
     }
     // in contact at both ends of the secant: a point that just touched moved with its neighbours
-    if (!(first_.eps[j] > 0.0) || !(f_first_[j] > 0.0) || !(f_reply_[j] > 0.0)) continue;
+    if (!(f_first_[j] > 0.0) || !(f_reply_[j] > 0.0)) continue;
     const Eigen::Vector3d n = reply_.n.segment<3>(3 * j);
     const double dd = n.dot(reply_.s.segment<3>(3 * j) - first_.s.segment<3>(3 * j));
     const double df = f_reply_[j] - f_first_[j];

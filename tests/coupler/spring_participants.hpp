@@ -82,6 +82,12 @@ struct WallSolid : participant::SolidParticipant {
   double s_max = 1.5;  // wall radius at t = 1 (linear ramp s = x0 + (s_max − x0)·t)
   double x0 = 1.0;
   double s = 1.0;
+  // Optional: the wall on springs, point i's surface giving way by q_i / kw_i (kw per unit length):
+  // the contact is the series spring of penalty and surface, eps' = eps kw / (eps + kw), so
+  // q~_i = eps' max(s − x_i − R, 0) and the coupled fixed point is q*_i = eps'_i (s − x0 − R) /
+  // (1 + eps'_i / kb). The planes sit on the displaced surface. Empty: a rigid wall.
+  std::vector<double> kw;
+  double eps_series(std::size_t i) const { return kw.empty() ? eps : eps * kw[i] / (eps + kw[i]); }
   void begin_step(int, double t) override { s = x0 + (s_max - x0) * t; }
   std::vector<double> tolerances;  // of every solve request (the wall is solved exactly anyway)
   participant::SolveStats solve(const participant::SamplePoints& p, participant::ContactReply& reply,
@@ -90,11 +96,12 @@ struct WallSolid : participant::SolidParticipant {
     reply = {};
     for (std::size_t i = 0; i < p.size(); ++i) {
       const double g = s - p.x[i][0] - p.radius[i];
-      const double q = eps * std::max(g, 0.0);
+      const double q = eps_series(i) * std::max(g, 0.0);
+      const double surface = kw.empty() ? s : s - q / kw[i];
       reply.line_loads.push_back({q, 0.0, 0.0});
       // robin data: the wall as a plane with normal +e_x toward the beam; the law
-      // −eps·((x − S) − R) with S = s − 2R equals eps·(s − x − R) above.
-      reply.surface_points.push_back({s - 2.0 * p.radius[i], p.x[i][1], p.x[i][2]});
+      // −eps·((x − S) − R) with S = surface − 2R equals eps·(surface − x − R) = q above.
+      reply.surface_points.push_back({surface - 2.0 * p.radius[i], p.x[i][1], p.x[i][2]});
       reply.normals.push_back({1.0, 0.0, 0.0});
       reply.penalty.push_back(eps);
       reply.total_force[0] += p.w[i] * q;
@@ -106,37 +113,6 @@ struct WallSolid : participant::SolidParticipant {
   }
   void end_step(bool) override {}
   void finish() override {}
-};
-
-// The wall of WallSolid on springs: point i's surface gives way by q_i / kw_i (kw per unit length,
-// one per point), so the contact is the series spring of the penalty and the surface,
-// eps' = eps kw / (eps + kw): q~_i = eps' max(s − x_i − R, 0), and the coupled fixed point is
-// q*_i = eps'_i (s − x0 − R) / (1 + eps'_i / kb). The planes it reports sit on the displaced surface.
-struct SoftWallSolid : WallSolid {
-  std::vector<double> kw;
-  double q_star(int i, double kb, double R) const {
-    const double e = eps * kw[i] / (eps + kw[i]);
-    return e * (s_max - x0 - R) / (1.0 + e / kb);
-  }
-  participant::SolveStats solve(const participant::SamplePoints& p, participant::ContactReply& reply,
-                                double tolerance) override {
-    tolerances.push_back(tolerance);
-    reply = {};
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double e = eps * kw[i] / (eps + kw[i]);
-      const double q = e * std::max(s - p.x[i][0] - p.radius[i], 0.0);
-      const double surface = s - q / kw[i];
-      reply.line_loads.push_back({q, 0.0, 0.0});
-      reply.surface_points.push_back({surface - 2.0 * p.radius[i], p.x[i][1], p.x[i][2]});
-      reply.normals.push_back({1.0, 0.0, 0.0});
-      reply.penalty.push_back(eps);
-      reply.total_force[0] += p.w[i] * q;
-      if (q > 0) ++reply.n_active;
-    }
-    participant::SolveStats st;
-    st.converged = true;
-    return st;
-  }
 };
 
 }  // namespace angio::test
