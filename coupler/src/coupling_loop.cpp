@@ -159,6 +159,7 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       beam.end_step(false);
       solid.end_step(false);
       acc.end_step(false);
+      scheme->reject();
       ++run.rejected_attempts;
       stepper.reject(failure);  // throws StepFailure below the minimum increment
       continue;

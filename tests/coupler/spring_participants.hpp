@@ -54,7 +54,9 @@ struct SpringBeam : participant::BeamParticipant {
   }
   // Robin mode: kb (x − x0) = c + plane load, with the plane law of plane_penalty.hpp along x
   // (normal ±e_x), solved in closed form for the active and the inactive branch.
+  std::vector<double> plane_eps;  // penalty of point 0's plane at every robin solve (0: none)
   participant::SolveStats solve_with_planes(const std::vector<Vec3>& c, const participant::ContactPlanes& p) override {
+    plane_eps.push_back(p.eps.empty() ? 0.0 : p.eps[0]);
     participant::SolveStats st = solve(c);
     for (int i = 0; i < n; ++i) {
       if (!(p.eps[i] > 0.0)) continue;

@@ -187,6 +187,38 @@ TEST(CouplingLoop, RobinSurfaceComplianceKeepsTheFixedPointAndSavesIterations) {
   EXPECT_LE(2 * soft, plain) << "iterations with surface compliance " << soft << ", without " << plain;
 }
 
+// A rejected step is tried again from plain planes (an estimate from a step whose contact set
+// changed can be far too soft, and would fail every cut of the step the same way): the beam gets
+// softened planes before the failure and the penalty itself in the attempt after it.
+TEST(CouplingLoop, RobinSurfaceComplianceStartsAgainFromPlainPlanesAfterARejectedStep) {
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  wall.kw = {0.05, 0.1, 0.2, 0.4};
+  beam.kb = 0.1;
+  beam.fail_at_step = 5;
+  coupler::CouplingSettings s;
+  s.scheme = "robin";
+  s.surface_compliance = true;
+  s.prediction = "constant";  // the failed step is cut, not retried from the last state
+  s.rel_tol = 1e-9;
+  s.abs_tol = 1e-12;
+  coupler::IqnIlsOptions o;
+  o.reused_steps = 0;
+  coupler::IqnIls iqn(o);
+  std::vector<std::size_t> solves_before;  // the beam's solve count at every accepted step
+  coupler::RunReport run = coupler::run_coupled(
+      beam, wall, ramp(8), s, iqn, [&](const coupler::StepReport&) { solves_before.push_back(beam.plane_eps.size()); });
+  ASSERT_EQ(run.rejected_attempts, 1);
+  ASSERT_GE(solves_before.size(), 5u);
+  // step 4's last solve had a softened plane; the failed attempt of step 5 too (its one solve);
+  // the attempt after it starts plain
+  EXPECT_LT(beam.plane_eps[solves_before[3] - 1], wall.eps);
+  EXPECT_LT(beam.plane_eps[solves_before[3]], wall.eps);
+  EXPECT_DOUBLE_EQ(beam.plane_eps[solves_before[3] + 1], wall.eps);
+  EXPECT_NEAR(beam.x_committed[0],
+              beam.x0 + wall.eps_series(0) * (wall.s_max - wall.x0 - beam.R) / (beam.kb + wall.eps_series(0)), 1e-7);
+}
+
 TEST(CouplingLoop, RobinSchemeNeedsABeamThatTakesPlanes) {
   // A beam participant without robin support fails its solve with a message saying so, and the
   // run ends with that message instead of hanging or silently running Dirichlet–Neumann.

@@ -35,6 +35,8 @@ class InterfaceScheme {
   virtual void next_iterate(Acceleration& acc, int k) = 0;
   // The step was accepted with the last force_residual(): remember the converged state.
   virtual void accept(double increment) = 0;
+  // The step was rejected and will be cut (its attempt is tried again from the accepted state).
+  virtual void reject() {}
   // The converged state of an earlier run, from the solid's reply at the beam's committed positions
   // x: taken as the accepted state of the step before the first (no extrapolation from it).
   void seed(const participant::SamplePoints& x, const participant::ContactReply& reply) {

@@ -36,6 +36,7 @@ class Robin : public InterfaceScheme {
   Eigen::VectorXd force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) override;
   void next_iterate(Acceleration& acc, int k) override;
   void accept(double increment) override;
+  void reject() override;
 
  private:
   struct Planes {
@@ -56,7 +57,7 @@ class Robin : public InterfaceScheme {
   void update_stiffness_();
   // p_tilde_: the last reply as an iterate (softened with surface compliance), reply_: as the solid
   // sent it; first_: the step's first reply (for the secant).
-  Planes p_, p_tilde_, p_last_, p_before_, reply_, first_;
+  Planes p_, p_tilde_, p_last_, p_before_, reply_, first_, accepted_reply_;
   bool compliance_ = false;
   Eigen::VectorXd k_;                  // per plane: surface stiffness estimate (N/mm²), 0 unknown
   Eigen::VectorXd f_first_, f_reply_;  // plane forces of first_ and reply_
