@@ -49,16 +49,25 @@ participant::SolveStats Robin::solve_beam(participant::BeamParticipant& beam) {
   return beam.solve_with_planes(unflatten(c_), planes);
 }
 
-Eigen::VectorXd Robin::plane_forces_(const participant::SamplePoints& x, const Planes& p) const {
+Eigen::VectorXd Robin::plane_forces(const participant::SamplePoints& x, const Planes& p) {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(p.eps.size());
+  const std::size_t K = std::size_t(p.eps.size()) / x.size();
   for (Eigen::Index j = 0; j < p.eps.size(); ++j) {
     if (!(p.eps[j] > 0.0)) continue;
-    const std::size_t i = std::size_t(j) / K_;
+    const std::size_t i = std::size_t(j) / K;
     const Eigen::Vector3d xi(x.x[i][0], x.x[i][1], x.x[i][2]);
     const Eigen::Vector3d n = p.n.segment<3>(3 * j);
     f[j] = participant::plane_penalty(xi, p.s.segment<3>(3 * j), n, p.eps[j], x.radius[i], p.g0).q.dot(n);
   }
   return f;
+}
+
+Eigen::VectorXd Robin::loads_of(const Planes& p, const Eigen::VectorXd& f, std::size_t n_points) {
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(3 * n_points);
+  const std::size_t K = std::size_t(p.eps.size()) / n_points;
+  for (Eigen::Index j = 0; j < f.size(); ++j)
+    if (f[j] != 0.0) q.segment<3>(3 * (std::size_t(j) / K)) += f[j] * p.n.segment<3>(3 * j);
+  return q;
 }
 
 Robin::Planes Robin::softened_(const participant::SamplePoints& x, const Planes& p, const Eigen::VectorXd& f) const {
@@ -103,19 +112,6 @@ void Robin::update_stiffness_() {
   }
 }
 
-Eigen::VectorXd Robin::plane_loads(const participant::SamplePoints& x, const Planes& p) {
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(3 * x.size());
-  const std::size_t K = std::size_t(p.eps.size()) / x.size();
-  for (Eigen::Index j = 0; j < p.eps.size(); ++j) {
-    if (!(p.eps[j] > 0.0)) continue;
-    const std::size_t i = std::size_t(j) / K;
-    const Eigen::Vector3d xi(x.x[i][0], x.x[i][1], x.x[i][2]);
-    q.segment<3>(3 * i) +=
-        participant::plane_penalty(xi, p.s.segment<3>(3 * j), p.n.segment<3>(3 * j), p.eps[j], x.radius[i], p.g0).q;
-  }
-  return q;
-}
-
 Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) {
   const std::size_t n = x.size();
   const std::size_t K = participant::planes_per_point(reply.penalty.size(), n);
@@ -129,15 +125,17 @@ Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const 
     set_planes_per_point_(K);
   }
   const Eigen::VectorXd q_tilde = flatten(reply.line_loads);
-  const Eigen::VectorXd q_beam = c_ + plane_loads(x, p_);  // what the beam applied at x
+  const Eigen::VectorXd q_beam = c_ + loads_of(p_, plane_forces(x, p_), n);  // what the beam applied at x
   reply_.s = flatten(reply.surface_points);
   reply_.n = flatten(reply.normals);
   reply_.g0 = reply.regularization;
   reply_.eps = Eigen::Map<const Eigen::VectorXd>(reply.penalty.data(), Eigen::Index(reply.penalty.size()));
+  f_reply_ = plane_forces(x, reply_);
+  // the remainder; softened planes carry the same loads at x, so it holds for either
+  c_tilde_ = q_tilde - loads_of(reply_, f_reply_, n);
   p_tilde_ = reply_;
   if (compliance_) {
     x_ = x;
-    f_reply_ = plane_forces_(x, reply_);
     if (!have_first_) {
       first_ = reply_;
       f_first_ = f_reply_;
@@ -145,7 +143,6 @@ Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const 
     }
     p_tilde_ = softened_(x, reply_, f_reply_);
   }
-  c_tilde_ = q_tilde - plane_loads(x, p_tilde_);
   return q_tilde - q_beam;
 }
 
@@ -181,9 +178,10 @@ void Robin::reject() {
 }
 
 void Robin::accept(double increment) {
-  accepted_reply_ = reply_;
   if (compliance_) {
-    // the new estimates apply from the accepted state on (the next step's first iterate)
+    accepted_reply_ = reply_;
+    // the new estimates apply from the accepted state on (the next step's first iterate; c_tilde_
+    // stays: the re-softened planes carry the same loads at x_)
     update_stiffness_();
     p_tilde_ = softened_(x_, reply_, f_reply_);
   }

@@ -352,7 +352,8 @@ def build_artery(
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.model.mesh.generate(3)
         gmsh.model.mesh.setOrder(2)  # tet10 / tri6 on the curved geometry
-        if _min_quadratic_jacobian() <= 0.0:
+        samples = _jacobian_samples()
+        if samples[2].size and samples[2].min() <= 0.0:
             # a mid-edge node pulled onto the curved boundary can invert a thin element: untangle
             # with gmsh's optimizer, and straighten what it leaves inverted
             gmsh.option.setNumber("Mesh.HighOrderOptimize", 2)
@@ -360,7 +361,8 @@ def build_artery(
                 gmsh.model.mesh.optimize("HighOrder")
             except Exception as e:  # gmsh raises a bare Exception when it cannot reach its target
                 log(f"patient: gmsh's high-order optimization stopped ({' '.join(str(e).split())})")
-        straightened, still_inverted = _straighten_inverted()
+            samples = _jacobian_samples()  # of the optimized mesh
+        straightened, still_inverted, samples = _straighten_inverted(samples)
         if straightened:
             log(
                 f"patient: {straightened} tet10 straightened (mid-edge nodes at the edge midpoints) to keep "
@@ -368,7 +370,7 @@ def build_artery(
             )
         if still_inverted:
             raise RuntimeError("gmsh produced an inverted tetrahedron")
-        quality, where_bad = _min_scaled_jacobian()
+        quality, where_bad = _min_scaled_jacobian(samples)
         if not quality > 0.0:  # positive at the samples but the corners' tetrahedron inverted: tangled
             raise RuntimeError(
                 f"gmsh produced a tangled tet10 near ({', '.join(f'{x:.2f}' for x in where_bad)}) mm (its corner "
@@ -446,18 +448,13 @@ def _jacobian_samples():
     return tags, np.asarray(nodes).reshape(-1, 10), dets, straight, c
 
 
-def _min_quadratic_jacobian():
-    """Smallest Jacobian determinant of the tet10 at the samples of _jacobian_samples."""
-    dets = _jacobian_samples()[2]
-    return float(dets.min()) if dets.size else math.inf
-
-
-def _min_scaled_jacobian():
+def _min_scaled_jacobian(samples):
     """The smallest scaled Jacobian of the tet10: det J at the Gauss points and the ten nodes, over
     det J of the element's straight-sided tet4 (1 for a straight-sided tet10, <= 0 inverted or
     folded; the measure gmsh's high-order optimizer works on), and the centroid of the worst element.
-    gmsh 4.8's own quality API has no scaled Jacobian, so it is computed from getJacobians."""
-    tags, _, dets, straight, c = _jacobian_samples()
+    gmsh 4.8's own quality API has no scaled Jacobian, so it is computed from getJacobians.
+    samples: _jacobian_samples() of the mesh as it is."""
+    tags, _, dets, straight, c = samples
     if not len(tags):
         return math.nan, np.zeros(3)
     q = dets.min(axis=1) / straight
@@ -469,15 +466,18 @@ def _min_scaled_jacobian():
 TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
 
 
-def _straighten_inverted(max_rounds=5):
+def _straighten_inverted(samples, max_rounds=5):
     """Moves the mid-edge nodes of tet10 with a non-positive Jacobian (at any sample of
-    _jacobian_samples) to their edge midpoints (a straight-sided tet10 is valid whenever its tet4
-    is); returns (how many elements were changed, how many are still inverted after max_rounds)."""
+    _jacobian_samples; `samples` those of the mesh as it is) to their edge midpoints (a
+    straight-sided tet10 is valid whenever its tet4 is); returns (how many elements were changed,
+    how many are still inverted after max_rounds, the samples of the mesh as it is then)."""
     import gmsh
 
     changed = set()
     for round_ in range(max_rounds + 1):
-        tags, nodes, dets, _, corner = _jacobian_samples()
+        if round_ > 0:
+            samples = _jacobian_samples()
+        tags, nodes, dets, _, corner = samples
         bad = np.nonzero(dets.min(axis=1) <= 0.0)[0]
         if not len(bad) or round_ == max_rounds:
             break
@@ -485,4 +485,4 @@ def _straighten_inverted(max_rounds=5):
             changed.add(int(tags[e]))
             for k, (a, b) in enumerate(TET10_EDGES):
                 gmsh.model.mesh.setNode(int(nodes[e, 4 + k]), list(0.5 * (corner[e, a] + corner[e, b])), [])
-    return len(changed), len(bad)
+    return len(changed), len(bad), samples

@@ -46,6 +46,6 @@ class InterfaceScheme {
 };
 
 std::unique_ptr<InterfaceScheme> make_interface_scheme(const std::string& name, std::size_t n_points,
-                                                       bool surface_compliance = false);
+                                                       bool surface_compliance);
 
 }  // namespace angio::coupler

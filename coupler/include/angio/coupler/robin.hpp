@@ -30,7 +30,7 @@ namespace angio::coupler {
 
 class Robin : public InterfaceScheme {
  public:
-  explicit Robin(std::size_t n_points, bool surface_compliance = false);
+  Robin(std::size_t n_points, bool surface_compliance);
   void begin_step(double increment, bool extrapolate) override;
   participant::SolveStats solve_beam(participant::BeamParticipant& beam) override;
   Eigen::VectorXd force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) override;
@@ -46,10 +46,10 @@ class Robin : public InterfaceScheme {
   // Sets the number of planes per point from the solid's first reply (fixed for a run).
   void set_planes_per_point_(std::size_t K);
   std::size_t n_ = 0, K_ = 1;
-  // Σ line loads of the planes at positions x (N/mm, 3 per point).
-  static Eigen::VectorXd plane_loads(const participant::SamplePoints& x, const Planes& p);
-  // Forces (N/mm, along n) of the planes p at positions x.
-  Eigen::VectorXd plane_forces_(const participant::SamplePoints& x, const Planes& p) const;
+  // Forces (N/mm, along n) of the planes p at positions x (the penalty law of plane_penalty.hpp).
+  static Eigen::VectorXd plane_forces(const participant::SamplePoints& x, const Planes& p);
+  // Σ line loads f_j n_j of the planes with forces f per point (N/mm, 3 per point).
+  static Eigen::VectorXd loads_of(const Planes& p, const Eigen::VectorXd& f, std::size_t n_points);
   // With surface compliance: the planes p (forces f at x) as series springs of penalty and surface
   // at the unloaded surface; planes without an estimate stay as they are.
   Planes softened_(const participant::SamplePoints& x, const Planes& p, const Eigen::VectorXd& f) const;
