@@ -31,6 +31,18 @@ class WallSpec:
     min_intima: float  # mm: thinner intima is refused (no elements fit in it)
 
 
+@dataclass
+class Refinement:
+    """Finer elements where the stresses are read: over the lumen arc lengths s_from..s_to (the
+    balloon's span and its margins) the element size is `size`; it grows to the mesh size over
+    `transition` mm beyond the outer wall's reach (gmsh Distance + Threshold fields)."""
+
+    s_from: float  # mm of lumen arc length
+    s_to: float
+    size: float  # mm
+    transition: float  # mm
+
+
 def rotation_minimizing_normals(pts):
     """Tangents and first normals along a polyline by the double reflection method (Wang, Jüttler,
     Zheng, Liu 2008, ACM TOG 27(1) 2): circles of successive stations start at corresponding
@@ -245,11 +257,13 @@ def build_artery(
     log=print,
     plaque=(),
     sections=None,
+    refine=None,
 ):
     """Mesh the artery and write it as gmsh MSH 4.1; returns a dict of mesh facts. `plaque`: the
     regions of the intima with their own volume group (plaque.PlaqueRegion, checked). `sections`: a
     lumen_sections.LumenSections whose true sections replace the circles of `radius` (and whose
-    wall-thickness field, if it has one, replaces `wall`)."""
+    wall-thickness field, if it has one, replaces `wall`). `refine`: a Refinement, or None for one
+    size throughout."""
     import gmsh
 
     s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
@@ -345,12 +359,16 @@ def build_artery(
                 raise RuntimeError(f"no faces found for the surface '{name}'")
             gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, tags), name)
         gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * mesh_size)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.2 * (refine.size if refine else mesh_size))
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
         gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
         gmsh.option.setNumber("Mesh.Optimize", 1)
         gmsh.option.setNumber("General.NumThreads", 1)
+        seeds = _refinement_field(refine, s, P, radii, mesh_size) if refine else []
         gmsh.model.mesh.generate(3)
+        if seeds:  # the field's seed points are no part of the artery: their nodes go, the rest renumbered
+            gmsh.model.mesh.clear(seeds)
+            gmsh.model.mesh.renumberNodes()
         gmsh.model.mesh.setOrder(2)  # tet10 / tri6 on the curved geometry
         samples = _jacobian_samples()
         if samples[2].size and samples[2].min() <= 0.0:
@@ -380,9 +398,10 @@ def build_artery(
         gmsh.option.setNumber("Mesh.Binary", 1 if binary else 0)
         gmsh.option.setNumber("Mesh.SaveAll", 0)
         gmsh.write(str(out_path))
-        types, tags, _ = gmsh.model.mesh.getElements(3)
+        types, tags, elem_nodes = gmsh.model.mesh.getElements(3)
         n_tets = sum(len(tg) for tg in tags)
-        node_tags, _, _ = gmsh.model.mesh.getNodes()
+        # the nodes the file holds (of the elements written), not every node gmsh's model has
+        node_tags = np.unique(np.concatenate(elem_nodes))
         per_layer = {
             name: sum(len(tg) for v in by_layer[name] for tg in gmsh.model.mesh.getElements(3, v)[1]) for name in groups
         }
@@ -393,6 +412,7 @@ def build_artery(
             "dofs": 3 * int(len(node_tags)),
             "per_layer": per_layer,
             "mesh_size": mesh_size,
+            "refinement": None if refine is None else dataclasses.asdict(refine),
             "straightened_tet10": int(straightened),
             "min_scaled_jacobian": quality,
             "stations": int(len(P)),
@@ -417,6 +437,39 @@ def build_artery(
         ) from e
     finally:
         gmsh.finalize()
+
+
+def _refinement_field(refine, s, P, radii, mesh_size):
+    """The background size field of a Refinement: the distance to centerline points of its span
+    (spaced at most half the fine size), the fine size out to the outer wall's largest radius in the
+    span plus half an element, growing linearly to mesh_size over the transition. Returns the seed
+    points' (dim, tag), to be cleared from the mesh after meshing."""
+    import gmsh
+
+    occ = gmsh.model.occ
+    lo, hi = max(refine.s_from, s[0]), min(refine.s_to, s[-1])
+    n = max(int(math.ceil((hi - lo) / (0.5 * refine.size))), 1) + 1
+    si = np.linspace(lo, hi, n)
+    seeds = [(0, occ.addPoint(*(np.interp(x, s, P[:, c]) for c in range(3)))) for x in si]
+    occ.synchronize()
+    span = (s >= lo - 1e-9) & (s <= hi + 1e-9)
+    outer = radii[:, 3]
+    reach = float((outer[span] if span.any() else outer).max()) + 0.5 * refine.size
+    field = gmsh.model.mesh.field
+    dist = field.add("Distance")
+    field.setNumbers(dist, "PointsList", [tag for _, tag in seeds])
+    size = field.add("Threshold")
+    field.setNumber(size, "InField", dist)
+    field.setNumber(size, "SizeMin", refine.size)
+    field.setNumber(size, "SizeMax", mesh_size)
+    field.setNumber(size, "DistMin", reach)
+    field.setNumber(size, "DistMax", reach + refine.transition)
+    field.setAsBackgroundMesh(size)
+    # the size comes from the field alone: not from the seed points' own size, not extended inward
+    # from the (coarse) boundary
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    return seeds
 
 
 def _size_hint(ti, tm, ta, mesh_size):

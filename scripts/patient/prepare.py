@@ -22,7 +22,7 @@ import numpy as np
 import insertion_tool
 import scene_keys
 
-from .artery_mesh import WallSpec, build_artery, layer_radii, section_at, section_frames
+from .artery_mesh import Refinement, WallSpec, build_artery, layer_radii, section_at, section_frames
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .centerline_vtp import read_centerline
 from .errors import PatientInputError
@@ -221,6 +221,23 @@ def station_sections(cl, sections):
     return rho, wall, labels, np.array([inscribed_radius(r) for r in rho])
 
 
+def refinement_of(mesh, plc, scene_path):
+    """The artery's Refinement from patient.mesh (checked), over the placed balloon's span on the
+    lumen centerline and the margin each side; None without patient.mesh.refine."""
+    if mesh["refine"] is None:
+        return None
+    key = "patient.mesh.refine"
+    ref = scene_keys.check_map(mesh["refine"], key, scene_path, PatientInputError)
+    if ref["size"] >= mesh["size"]:
+        raise PatientInputError(
+            f"{scene_path}: {key}.size: expected a size below patient.mesh.size ({mesh['size']:g} mm), "
+            f"got {ref['size']:g}"
+        )
+    return Refinement(
+        s_from=plc.s0 - ref["margin"], s_to=plc.s1 + ref["margin"], size=ref["size"], transition=ref["transition"]
+    )
+
+
 def prepare_scene(scene, scene_path, out_dir, log=print):
     """The completed scene (a new dict) with its generated files in out_dir; PatientInputError on bad input."""
     scene_path = Path(scene_path)
@@ -354,6 +371,12 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         f"{f', inscribed {2 * plc.site_radius:.3f} mm' if sections is not None else ''}); {fit}; meshing "
         f"the artery (size {mesh['size']:g} mm)"
     )
+    refine = refinement_of(mesh, plc, scene_path)
+    if refine:
+        log(
+            f"patient: elements of {refine.size:g} mm over s = {refine.s_from:.2f} .. {refine.s_to:.2f} mm (the "
+            f"balloon and its margins), {mesh['size']:g} mm elsewhere"
+        )
     info = build_artery(
         cl.points,
         cl.radius,
@@ -367,6 +390,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         log=log,
         plaque=plaque,
         sections=sections,
+        refine=refine,
     )
     log(
         f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs), minimal scaled "

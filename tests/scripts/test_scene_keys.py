@@ -73,7 +73,7 @@ class SceneKeys(unittest.TestCase):
 
     def test_check_map_fills_defaults_and_names_the_key(self):
         got = scene_keys.check_map({"size": 0.4}, "patient.mesh", "s.yaml", PatientInputError)
-        self.assertEqual(got, {"size": 0.4, "binary": True, "loft_spacing": 0.5})
+        self.assertEqual(got, {"size": 0.4, "binary": True, "loft_spacing": 0.5, "refine": None})
         cases = [
             ({"siez": 0.4}, "s.yaml: patient.mesh.siez: unknown key", "did you mean `size`?"),
             ({"size": -1}, "s.yaml: patient.mesh.size: expected a positive number (mm), got -1", ""),
