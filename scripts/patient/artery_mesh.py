@@ -35,12 +35,14 @@ class WallSpec:
 class Refinement:
     """Finer elements where the stresses are read: over the lumen arc lengths s_from..s_to (the
     balloon's span and its margins) the element size is `size`; it grows to the mesh size over
-    `transition` mm beyond the outer wall's reach (gmsh Distance + Threshold fields)."""
+    `transition` mm beyond the outer wall's reach (gmsh Distance + Threshold fields). With `layers`,
+    only in those layers (and on their boundaries: the next layer grows from the fine interface)."""
 
     s_from: float  # mm of lumen arc length
     s_to: float
     size: float  # mm
     transition: float  # mm
+    layers: tuple = ()  # volume group names; empty: every layer
 
 
 def rotation_minimizing_normals(pts):
@@ -364,7 +366,16 @@ def build_artery(
         gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay
         gmsh.option.setNumber("Mesh.Optimize", 1)
         gmsh.option.setNumber("General.NumThreads", 1)
-        seeds = _refinement_field(refine, s, P, radii, mesh_size) if refine else []
+        seeds = []
+        if refine:
+            unknown = sorted(set(refine.layers) - set(groups))
+            if unknown:
+                raise PatientInputError(
+                    f"{where}: patient.mesh.refine.layers: unknown layer {unknown[0]!r}, expected some of "
+                    f"{', '.join(groups)}"
+                )
+            volumes = [v for name in refine.layers for v in by_layer[name]]
+            seeds = _refinement_field(refine, s, P, radii, mesh_size, volumes)
         gmsh.model.mesh.generate(3)
         if seeds:  # the field's seed points are no part of the artery: their nodes go, the rest renumbered
             gmsh.model.mesh.clear(seeds)
@@ -439,11 +450,12 @@ def build_artery(
         gmsh.finalize()
 
 
-def _refinement_field(refine, s, P, radii, mesh_size):
+def _refinement_field(refine, s, P, radii, mesh_size, volumes):
     """The background size field of a Refinement: the distance to centerline points of its span
     (spaced at most half the fine size), the fine size out to the outer wall's largest radius in the
-    span plus half an element, growing linearly to mesh_size over the transition. Returns the seed
-    points' (dim, tag), to be cleared from the mesh after meshing."""
+    span plus half an element, growing linearly to mesh_size over the transition; restricted to
+    `volumes` (and their boundaries) unless empty. Returns the seed points' (dim, tag), to be
+    cleared from the mesh after meshing."""
     import gmsh
 
     occ = gmsh.model.occ
@@ -464,6 +476,15 @@ def _refinement_field(refine, s, P, radii, mesh_size):
     field.setNumber(size, "SizeMax", mesh_size)
     field.setNumber(size, "DistMin", reach)
     field.setNumber(size, "DistMax", reach + refine.transition)
+    if volumes:
+        where = field.add("Restrict")
+        field.setNumber(where, "InField", size)
+        faces = gmsh.model.getBoundary([(3, v) for v in volumes], combined=False, oriented=False)
+        curves = gmsh.model.getBoundary(faces, combined=False, oriented=False)
+        field.setNumbers(where, "VolumesList", volumes)
+        field.setNumbers(where, "SurfacesList", sorted({abs(t) for _, t in faces}))
+        field.setNumbers(where, "CurvesList", sorted({abs(t) for _, t in curves}))
+        size = where
     field.setAsBackgroundMesh(size)
     # the size comes from the field alone: not from the seed points' own size, not extended inward
     # from the (coarse) boundary

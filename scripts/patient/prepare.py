@@ -233,8 +233,15 @@ def refinement_of(mesh, plc, scene_path):
             f"{scene_path}: {key}.size: expected a size below patient.mesh.size ({mesh['size']:g} mm), "
             f"got {ref['size']:g}"
         )
+    layers = ref["layers"] or []
+    if not all(isinstance(x, str) for x in layers):
+        raise PatientInputError(f"{scene_path}: {key}.layers: expected a list of layer names, got {layers!r:.60}")
     return Refinement(
-        s_from=plc.s0 - ref["margin"], s_to=plc.s1 + ref["margin"], size=ref["size"], transition=ref["transition"]
+        s_from=plc.s0 - ref["margin"],
+        s_to=plc.s1 + ref["margin"],
+        size=ref["size"],
+        transition=ref["transition"],
+        layers=tuple(layers),
     )
 
 
@@ -375,7 +382,8 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     if refine:
         log(
             f"patient: elements of {refine.size:g} mm over s = {refine.s_from:.2f} .. {refine.s_to:.2f} mm (the "
-            f"balloon and its margins), {mesh['size']:g} mm elsewhere"
+            f"balloon and its margins){' in ' + ', '.join(refine.layers) if refine.layers else ''}, "
+            f"{mesh['size']:g} mm elsewhere"
         )
     info = build_artery(
         cl.points,

@@ -369,12 +369,46 @@ class ArteryMesh(unittest.TestCase):
             self.assertLess(mid, 1.3 * 0.3, "the span is meshed at the fine size")
             self.assertGreater(ends, 1.5 * mid, "away from the span the mesh stays coarse")
 
+            # the fine size in the intima only: the adventitia over the span stays coarser
+            intima_only = Path(d) / "intima.msh"
+            build_artery(
+                pts,
+                r,
+                wall,
+                spec,
+                0.9,
+                intima_only,
+                log=lambda m: None,
+                refine=Refinement(4.0, 8.0, 0.3, 1.0, layers=("intima",)),
+            )
+            m = meshio.read(intima_only)
+            name_of = {int(v[0]): k for k, v in m.field_data.items() if int(v[1]) == 3}
+            per_layer = {}
+            for block, tags in zip(m.cells, m.cell_data["gmsh:physical"]):
+                if block.type.startswith("tetra"):
+                    per_layer.setdefault(name_of[int(tags[0])], []).append(block.data)
+            mean_edge = {}
+            for name, blocks in per_layer.items():
+                t = np.vstack(blocks)
+                c = m.points[t[:, :4]].mean(axis=1)
+                s_of = arc_length(pts)[np.linalg.norm(c[:, None] - pts[None], axis=2).argmin(axis=1)]
+                e = np.mean([np.linalg.norm(m.points[t[:, i]] - m.points[t[:, j]], axis=1) for i, j in TET10_EDGES], 0)
+                mean_edge[name] = e[(s_of > 5.0) & (s_of < 7.0)].mean()
+            self.assertLess(mean_edge["intima"], 1.3 * 0.3, mean_edge)
+            self.assertGreater(mean_edge["adventitia"], 1.3 * mean_edge["intima"], mean_edge)
+            with self.assertRaisesRegex(PatientInputError, r"patient.mesh.refine.layers: unknown layer 'intma'"):
+                build_artery(
+                    pts, r, wall, spec, 0.9, intima_only, log=lambda m: None, refine=Refinement(4, 8, 0.3, 1, ("intma",))
+                )
+
     def test_refinement_refused_when_not_finer(self):
         # checked before the placement is read (None here)
         with self.assertRaisesRegex(PatientInputError, r"s.yaml: patient.mesh.refine.size: expected a size below"):
             refinement_of({"size": 0.8, "refine": {"size": 0.8}}, None, "s.yaml")
         with self.assertRaisesRegex(PatientInputError, r"s.yaml: patient.mesh.refine.sise: unknown key"):
             refinement_of({"size": 0.8, "refine": {"sise": 0.3}}, None, "s.yaml")
+        with self.assertRaisesRegex(PatientInputError, r"s.yaml: patient.mesh.refine.layers: expected a list of layer"):
+            refinement_of({"size": 0.8, "refine": {"size": 0.3, "layers": [1]}}, None, "s.yaml")
 
     def test_thin_wall_refused(self):
         pts, r, wall = arc(n=30, length=6.0)
