@@ -12,7 +12,7 @@ Knobs (each ladder holds the scene's own setting, "shipped"; the others are kept
   coupling_tol  coupling.rel_tol 1e-2, 3e-3, 1e-3, 3e-4, 1e-4
   newton_tol    solid.newton.rtol 1e-4, 1e-6, 1e-8, 1e-10, atol scaled alike (its ratio to rtol kept)
   mesh          balloon/artery divisions x 1, 1.5, 2 per direction (tube generators; a patient
-                artery: patient.mesh.size / 1, 1.5, 2)
+                artery: patient.mesh.size and refine.size / 1, 1.5, 2)
   beam          stent.generator.elements_per_strut (and per connector) 2, 3, 4, 6
 --quick: steps x 1/2, 1, 2; coupling_tol 1e-2, 1e-3, 1e-4; beam 2, 3 (a ladder CI can afford on a
 short scene).
@@ -91,6 +91,8 @@ def _set_mesh(s, f):
     pm = s.get("patient", {}).get("mesh")
     if isinstance(pm, dict):
         pm["size"] = pm.get("size", default("patient.mesh.size")) / f
+        if isinstance(pm.get("refine"), dict) and "size" in pm["refine"]:
+            pm["refine"]["size"] /= f  # the fine span refined alike
 
 
 def _set_beam(s, n):

@@ -133,4 +133,15 @@ with tempfile.TemporaryDirectory(prefix="wp-quick-") as tmp:
             "the shipped run is the run directory's (its wall time, the same outputs)",
         )
 
+# the mesh knob on a patient artery scales its size and the refined span's alike
+sys.path.insert(0, str(ROOT / "bench"))
+import work_precision  # noqa: E402
+
+pat = {"patient": {"mesh": {"size": 0.8, "refine": {"size": 0.4, "layers": ["intima"]}}}}
+work_precision._set_mesh(pat, 2.0)
+check(
+    pat["patient"]["mesh"] == {"size": 0.4, "refine": {"size": 0.2, "layers": ["intima"]}},
+    f"mesh knob x2 on a patient artery: size and refine.size halved ({pat['patient']['mesh']})",
+)
+
 finish()
