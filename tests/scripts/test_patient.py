@@ -398,7 +398,14 @@ class ArteryMesh(unittest.TestCase):
             self.assertGreater(mean_edge["adventitia"], 1.3 * mean_edge["intima"], mean_edge)
             with self.assertRaisesRegex(PatientInputError, r"patient.mesh.refine.layers: unknown layer 'intma'"):
                 build_artery(
-                    pts, r, wall, spec, 0.9, intima_only, log=lambda m: None, refine=Refinement(4, 8, 0.3, 1, ("intma",))
+                    pts,
+                    r,
+                    wall,
+                    spec,
+                    0.9,
+                    intima_only,
+                    log=lambda m: None,
+                    refine=Refinement(4, 8, 0.3, 1, ("intma",)),
                 )
 
     def test_refinement_refused_when_not_finer(self):
