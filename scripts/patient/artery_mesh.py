@@ -268,6 +268,12 @@ def build_artery(
     size throughout."""
     import gmsh
 
+    names = list(LAYERS) + sorted({reg.layer for reg in plaque})  # the volume groups the mesh will have
+    unknown = sorted(set(refine.layers) - set(names)) if refine else []
+    if unknown:
+        raise PatientInputError(
+            f"{where}: patient.mesh.refine.layers: unknown layer {unknown[0]!r}, expected some of {', '.join(names)}"
+        )
     s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
     t, n1, n2 = section_frames(P)
     if sections is not None:
@@ -311,7 +317,7 @@ def build_artery(
                 if pie in tags and (inner is None or inner not in tags) and (outer is None or outer in tags):
                     region_of[dt] = reg.layer
                     break
-        groups = list(LAYERS) + sorted({reg.layer for reg in plaque})
+        groups = names
         by_layer = {name: [] for name in groups}
         core = []
         for dt, k in count.items():
@@ -368,12 +374,6 @@ def build_artery(
         gmsh.option.setNumber("General.NumThreads", 1)
         seeds = []
         if refine:
-            unknown = sorted(set(refine.layers) - set(groups))
-            if unknown:
-                raise PatientInputError(
-                    f"{where}: patient.mesh.refine.layers: unknown layer {unknown[0]!r}, expected some of "
-                    f"{', '.join(groups)}"
-                )
             volumes = [v for name in refine.layers for v in by_layer[name]]
             seeds = _refinement_field(refine, s, P, radii, mesh_size, volumes)
         gmsh.model.mesh.generate(3)
