@@ -345,68 +345,49 @@ class ArteryMesh(unittest.TestCase):
             finally:
                 gmsh.finalize()
 
+        def build(path, refine=None):
+            return build_artery(pts, r, wall, spec, 0.9, path, log=lambda m: None, refine=refine)
+
+        def mean_edge(X, t, lo, hi):
+            """Mean edge length of the tets whose centroid lies over lumen arc lengths lo..hi."""
+            c = X[t[:, :4]].mean(axis=1)
+            s_of = arc_length(pts)[np.linalg.norm(c[:, None] - pts[None], axis=2).argmin(axis=1)]
+            e = np.mean([np.linalg.norm(X[t[:, i]] - X[t[:, j]], axis=1) for i, j in TET10_EDGES], axis=0)
+            return e[(s_of > lo) & (s_of < hi)].mean()
+
         with tempfile.TemporaryDirectory(prefix=f"patient-refine-{os.getpid()}-") as d:
-            coarse = Path(d) / "coarse.msh"
-            fine = Path(d) / "fine.msh"
-            build_artery(pts, r, wall, spec, 0.9, coarse, log=lambda m: None)
-            info = build_artery(
-                pts, r, wall, spec, 0.9, fine, log=lambda m: None, refine=Refinement(4.0, 8.0, 0.3, 1.0)
-            )
+            coarse, fine, intima_only = (Path(d) / f"{n}.msh" for n in ("coarse", "fine", "intima"))
+            build(coarse)
+            info = build(fine, Refinement(4.0, 8.0, 0.3, 1.0))
             vc, vf = layer_volumes(coarse), layer_volumes(fine)
             self.assertEqual(set(vc), set(vf))
             for name in vc:
                 self.assertAlmostEqual(vf[name] / vc[name], 1.0, delta=0.01, msg=name)
             m = meshio.read(fine)
-            X = m.points
             t = np.vstack([b.data for b in m.cells if b.type.startswith("tetra")])
-            self.assertEqual(len(np.unique(t)), len(X))  # every node in an element: the seeds are gone
-            self.assertEqual(info["nodes"], len(X))
-            c = X[t[:, :4]].mean(axis=1)
-            s_of = arc_length(pts)[np.linalg.norm(c[:, None] - pts[None], axis=2).argmin(axis=1)]
-            edge = np.mean([np.linalg.norm(X[t[:, i]] - X[t[:, j]], axis=1) for i, j in TET10_EDGES], axis=0)
-            mid, ends = edge[(s_of > 5.0) & (s_of < 7.0)].mean(), edge[(s_of < 1.0) | (s_of > 11.0)].mean()
+            self.assertEqual(len(np.unique(t)), len(m.points))  # every node in an element: the seeds are gone
+            self.assertEqual(info["nodes"], len(m.points))
+            mid = mean_edge(m.points, t, 5.0, 7.0)
             # a tet's mean edge is about its size (within the mesher's spread, 30 %)
             self.assertLess(mid, 1.3 * 0.3, "the span is meshed at the fine size")
-            self.assertGreater(ends, 1.5 * mid, "away from the span the mesh stays coarse")
+            for lo, hi in ((0.0, 1.0), (11.0, 12.0)):
+                self.assertGreater(
+                    mean_edge(m.points, t, lo, hi), 1.5 * mid, "away from the span the mesh stays coarse"
+                )
 
             # the fine size in the intima only: the adventitia over the span stays coarser
-            intima_only = Path(d) / "intima.msh"
-            build_artery(
-                pts,
-                r,
-                wall,
-                spec,
-                0.9,
-                intima_only,
-                log=lambda m: None,
-                refine=Refinement(4.0, 8.0, 0.3, 1.0, layers=("intima",)),
-            )
+            build(intima_only, Refinement(4.0, 8.0, 0.3, 1.0, layers=("intima",)))
             m = meshio.read(intima_only)
             name_of = {int(v[0]): k for k, v in m.field_data.items() if int(v[1]) == 3}
             per_layer = {}
             for block, tags in zip(m.cells, m.cell_data["gmsh:physical"]):
                 if block.type.startswith("tetra"):
                     per_layer.setdefault(name_of[int(tags[0])], []).append(block.data)
-            mean_edge = {}
-            for name, blocks in per_layer.items():
-                t = np.vstack(blocks)
-                c = m.points[t[:, :4]].mean(axis=1)
-                s_of = arc_length(pts)[np.linalg.norm(c[:, None] - pts[None], axis=2).argmin(axis=1)]
-                e = np.mean([np.linalg.norm(m.points[t[:, i]] - m.points[t[:, j]], axis=1) for i, j in TET10_EDGES], 0)
-                mean_edge[name] = e[(s_of > 5.0) & (s_of < 7.0)].mean()
-            self.assertLess(mean_edge["intima"], 1.3 * 0.3, mean_edge)
-            self.assertGreater(mean_edge["adventitia"], 1.3 * mean_edge["intima"], mean_edge)
+            edge = {name: mean_edge(m.points, np.vstack(b), 5.0, 7.0) for name, b in per_layer.items()}
+            self.assertLess(edge["intima"], 1.3 * 0.3, edge)
+            self.assertGreater(edge["adventitia"], 1.3 * edge["intima"], edge)
             with self.assertRaisesRegex(PatientInputError, r"patient.mesh.refine.layers: unknown layer 'intma'"):
-                build_artery(
-                    pts,
-                    r,
-                    wall,
-                    spec,
-                    0.9,
-                    intima_only,
-                    log=lambda m: None,
-                    refine=Refinement(4, 8, 0.3, 1, ("intma",)),
-                )
+                build(intima_only, Refinement(4, 8, 0.3, 1, ("intma",)))
 
     def test_refinement_refused_when_not_finer(self):
         # checked before the placement is read (None here)
