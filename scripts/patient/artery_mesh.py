@@ -268,11 +268,11 @@ def build_artery(
     size throughout."""
     import gmsh
 
-    names = list(LAYERS) + sorted({reg.layer for reg in plaque})  # the volume groups the mesh will have
-    unknown = sorted(set(refine.layers) - set(names)) if refine else []
+    groups = list(LAYERS) + sorted({reg.layer for reg in plaque})  # the volume groups the mesh will have
+    unknown = sorted(set(refine.layers) - set(groups)) if refine else []
     if unknown:
         raise PatientInputError(
-            f"{where}: patient.mesh.refine.layers: unknown layer {unknown[0]!r}, expected some of {', '.join(names)}"
+            f"{where}: patient.mesh.refine.layers: unknown layer {unknown[0]!r}, expected some of {', '.join(groups)}"
         )
     s, P, (r, w) = resample(points, [radius, wall], loft_spacing)
     t, n1, n2 = section_frames(P)
@@ -317,7 +317,6 @@ def build_artery(
                 if pie in tags and (inner is None or inner not in tags) and (outer is None or outer in tags):
                     region_of[dt] = reg.layer
                     break
-        groups = names
         by_layer = {name: [] for name in groups}
         core = []
         for dt, k in count.items():
