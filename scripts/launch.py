@@ -589,22 +589,34 @@ def run_procedure(scene, scene_path, scene_text, args):
     passed += ["--timeout", str(args.timeout)] if args.timeout is not None else []
     passed += ["--endpoint", args.endpoint] if args.endpoint else []
     try:
+        procedure.phases(scene, scene_path)
         if args.check:
             procedure.check(scene, scene_path, passed)
             print(f"launch: {scene_path}: the procedure is valid (every phase checked)")
             return 0
-        procedure.phases(scene, scene_path)
-        procedure.check(scene, scene_path, passed)
     except procedure.ProcedureError as e:
         die(str(e))
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = Path(args.run_dir or ROOT / "runs" / f"{scene_path.stem}-{stamp}-{uuid.uuid4().hex[:12]}").resolve()
+    fresh = not run_dir.exists()
     make_run_dir(run_dir, explicit=args.run_dir is not None)
     lock = lock_run_dir(run_dir)  # noqa: F841 (held until return)
+    # A patient procedure is meshed and placed once, by the check, into the run's geometry/; a check
+    # that fails leaves no run directory behind (a reused one keeps what it had but that geometry/).
+    geometry = run_dir / "geometry"
+    had_geometry = geometry.exists()
+    try:
+        completed = procedure.check(scene, scene_path, passed, geometry_dir=geometry)
+    except procedure.ProcedureError as e:
+        if fresh:
+            shutil.rmtree(run_dir, ignore_errors=True)
+        elif not had_geometry:
+            shutil.rmtree(geometry, ignore_errors=True)
+        die(str(e))
     (run_dir / "scene.yaml").write_bytes(scene_text)
     print(f"launch: procedure run directory {run_dir}")
     try:
-        return procedure.run(scene, scene_path, run_dir, passed)
+        return procedure.run(scene, scene_path, run_dir, passed, completed=completed)
     except procedure.ProcedureError as e:
         die(str(e))
 

@@ -413,20 +413,23 @@ def _write(path, scene, note):
     path.write_text(f"# {note}\n" + yaml.safe_dump(scene, sort_keys=False))
 
 
-def check(scene, path, launch_args):
-    """Every phase's scene through `launch.py --check` (without the states, which do not exist yet);
-    a patient procedure is completed (meshed and placed) into a scratch directory first."""
+def check(scene, path, launch_args, geometry_dir=None):
+    """Every phase's scene through `launch.py --check` (without the states, which do not exist yet).
+    A patient procedure is completed (meshed and placed) first, into geometry_dir (the run's own
+    `geometry/`, so that run() does not mesh it again) or, without it, into a scratch directory.
+    Returns the completed (scene, placement) for run()."""
     with tempfile.TemporaryDirectory(prefix="angio-procedure-") as tmp:
-        scene, _ = complete(scene, path, Path(tmp) / "geometry")
-        for k, ph in enumerate(phases(scene, path)):
+        done, placement = complete(scene, path, Path(geometry_dir) if geometry_dir else Path(tmp) / "geometry")
+        for k, ph in enumerate(phases(done, path)):
             p = Path(tmp) / f"{k + 1}-{ph['name']}.yaml"
-            _write(p, phase_scene(scene, ph), f"phase {k + 1} of {path}, as checked")
+            _write(p, phase_scene(done, ph), f"phase {k + 1} of {path}, as checked")
             r = subprocess.run(
                 [sys.executable, str(LAUNCH), str(p), "--check"] + launch_args, capture_output=True, text=True
             )
             if r.returncode != 0:
                 msg = (r.stderr.strip() or r.stdout.strip()).splitlines()
                 raise ProcedureError(f"{path}: procedure[{k}] ({ph['name']}): {msg[-1] if msg else 'check failed'}")
+    return done, placement
 
 
 # --- results per phase -------------------------------------------------------------------------
@@ -612,11 +615,12 @@ def summarize(run_dir, scene, path, ran, tools=None):
     return out
 
 
-def run(scene, path, run_dir, launch_args):
+def run(scene, path, run_dir, launch_args, completed=None):
     """Runs the phases one after the other (launch.py per phase); returns the exit code of the first
-    failing phase, else 0."""
+    failing phase, else 0. completed: what check() returned with geometry_dir = <run_dir>/geometry
+    (a patient procedure meshed and placed there), else it is completed here."""
     run_dir = Path(run_dir)
-    scene, placement = complete(scene, path, run_dir / "geometry")  # a patient procedure: meshed and placed here
+    scene, placement = completed or complete(scene, path, run_dir / "geometry")
     ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
     ran, previous, code, tools, placed = [], None, 0, {}, None
     for k, phase in enumerate(ph):

@@ -263,7 +263,9 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         )
     dev = device_of(scene, scene_path)
 
-    csv_path, sections, label_spec = lumen_csv(pat, scene_path, Path(out_dir), log)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)  # a procedure's check prepares into a fresh scratch directory
+    csv_path, sections, label_spec = lumen_csv(pat, scene_path, out, log)
     cl = read_centerline_csv(csv_path)
     if wall["thickness"] in ("from_surface", "from_outer_surface") and not pat["lumen_surface"]:
         raise PatientInputError(
@@ -309,7 +311,6 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
     )
     insertion = ins["mode"] == "auto" and not devices_fit(cl_fit, dev, s_site, margin=spl["clearance"])
     plc = place_device(cl_fit, dev, s_site, zeta=spl["smoothing"], margin=spl["clearance"], insertion=insertion)
-    out = Path(out_dir)
     dev_file = out / "device_centerline.txt"
     lumen_file = out / "lumen_centerline.txt"
     spec = WallSpec(

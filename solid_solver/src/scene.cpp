@@ -403,6 +403,16 @@ void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc)
                                          scene::keys::peaks::artery_blood_pressure,
                                          scene::keys::peaks::artery_blood_pressure_why));
   read_end_springs(a, "artery", m, sc);
+  // The perivascular tissue (myocardium, epicardial fat) holds a coronary in place: without it a soft
+  // curved segment held at its cut ends only bows out of its bend under the blood pressure's resultant
+  // p A / R per unit length, amplified by the pressure's effective axial compression p A (a pressurized
+  // tube without axial prestretch near Euler buckling; Han, J Biomech 40 (2007) 3672). Springs on the
+  // outer surface, as an external tissue support (Moireau et al., Biomech Model Mechanobiol 11 (2012) 1).
+  if (a.has("tissue_support")) {
+    if (!m.surface("artery_outer"))
+      a.child("tissue_support").fail("an artery mesh with an outer surface (mesh.outer) to carry the springs");
+    sc.springs.push_back({"artery_outer", a.get<double>("tissue_support")});
+  }
   read_fixed(a, "artery_", m, sc.fixed);
   if (m.surface("artery_inner")) {
     DiameterSpec d;

@@ -231,6 +231,21 @@ with tempfile.TemporaryDirectory(prefix="patient-short-") as tmp:
         p.returncode == 2 and "procedure[2].balloon.mesh.length" in msg,
         f"a phase balloon longer than the device centerline: exit {p.returncode}, '{msg[:200]}'",
     )
+    # the same launched for a run: the check meshes into the run's geometry/ (once, for the run) and,
+    # failing, leaves no run directory behind
+    long_scene = Path(tmp) / "procedure_long.yaml"
+    long_run = Path(tmp) / "procedure_long_run"
+    p = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "launch.py"), str(long_scene), "--run-dir", str(long_run)]
+        + ["--build-dir", str(Path(BIN).parent)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    check(
+        p.returncode == 2 and not long_run.exists(),
+        f"a procedure whose check fails: exit {p.returncode} (2), run directory left: {long_run.exists()}",
+    )
 
     # bad input: exit 2 naming the file and the problem (before anything is meshed)
     bad = [

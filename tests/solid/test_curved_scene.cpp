@@ -86,3 +86,26 @@ TEST(CurvedScene, ErrorsNameFileAndKey) {
     std::filesystem::remove(path);
   }
 }
+
+// artery.tissue_support: springs of the given stiffness on the artery's outer surface, besides its
+// end springs (compared with the scene's numbers); absent, none.
+TEST(CurvedScene, TissueSupportSpringsOnTheOuterSurface) {
+  const auto path = std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_tissue_support.yaml");
+  auto scene_with = [&](const std::string& support) {
+    std::ofstream f(path);
+    f << "time: {end: 1.0, steps: 1}\nartery:\n  mesh: {generator: tube, length: 4.0, outer_diameter: 2.8, n_circ: 8, "
+         "n_axial: 4, layers: [{name: media, thickness: 0.3, n_radial: 1}]}\n  layers: {media: {E: 0.1566, nu: 0.45}}\n"
+         "  blood_pressure: 0.01133\n  end_springs: 1000.0\n"
+      << support;
+    f.close();
+    return read_solid_scene(angio::scene::load_scene(path.string()));
+  };
+  const SolidScene with = scene_with("  tissue_support: 0.005\n");
+  ASSERT_EQ(with.springs.size(), 3u);
+  EXPECT_EQ(with.springs[2].surface, "artery_outer");
+  EXPECT_DOUBLE_EQ(with.springs[2].stiffness, 0.005);
+  ASSERT_NE(with.mesh.surface("artery_outer"), nullptr);
+  EXPECT_FALSE(with.mesh.surface("artery_outer")->faces.empty());
+  EXPECT_EQ(scene_with("").springs.size(), 2u);
+  std::filesystem::remove(path);
+}
