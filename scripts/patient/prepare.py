@@ -22,7 +22,7 @@ import numpy as np
 import insertion_tool
 import scene_keys
 
-from .artery_mesh import Refinement, WallSpec, build_artery, layer_radii, section_at, section_frames
+from .artery_mesh import SLIVER_QUALITY, Refinement, WallSpec, build_artery, layer_radii, section_at, section_frames
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .centerline_vtp import read_centerline
 from .errors import PatientInputError
@@ -405,6 +405,14 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
         f"patient: artery {info['elements']} tet10, {info['nodes']} nodes ({info['dofs']} DOFs), minimal scaled "
         f"Jacobian {info['min_scaled_jacobian']:.3f}"
     )
+    worst = info["worst_shape"]
+    if worst["quality"] < SLIVER_QUALITY:
+        log(
+            f"patient: warning: slivers in the artery mesh: the flattest tetrahedron, in {worst['layer']} at "
+            f"({', '.join(f'{x:.2f}' for x in worst['at'])}) mm, has a shape quality of {worst['quality']:.2g} "
+            f"(1 regular, below {SLIVER_QUALITY} flat; per layer in placement.json, artery_mesh.min_shape_quality): "
+            "the wall's Newton may fail there; a smaller patient.mesh.size, or patient.mesh.refine over that layer"
+        )
     report = {
         "centerline": str(csv_path),
         "points": int(len(cl.radius)),

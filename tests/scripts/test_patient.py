@@ -14,7 +14,15 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scripts"))
-from patient.artery_mesh import TET10_EDGES, Refinement, WallSpec, build_artery, layer_radii  # noqa: E402
+from patient.artery_mesh import (  # noqa: E402
+    SLIVER_QUALITY,
+    TET10_EDGES,
+    Refinement,
+    WallSpec,
+    _shape_quality,
+    build_artery,
+    layer_radii,
+)
 from patient.centerline_csv import arc_length, read_centerline_csv, write_centerline_csv  # noqa: E402
 from patient.errors import PatientInputError  # noqa: E402
 from patient.placement import (  # noqa: E402
@@ -282,6 +290,12 @@ class ArteryMesh(unittest.TestCase):
                 out = Path(d) / f"a{int(binary)}.msh"
                 info = build_artery(pts, r, wall, spec, 0.9, out, binary=binary, log=lambda m: None)
                 self.assertGreater(info["elements"], 50)
+                # shape quality per layer, the worst one where it is (no slivers in a plain tube)
+                shape = info["min_shape_quality"]
+                self.assertEqual(set(shape), {"intima", "media", "adventitia"})
+                self.assertTrue(all(SLIVER_QUALITY < q <= 1.0 for q in shape.values()), shape)
+                self.assertEqual(info["worst_shape"]["quality"], min(shape.values()))
+                self.assertEqual(shape[info["worst_shape"]["layer"]], info["worst_shape"]["quality"])
                 gmsh.initialize()
                 try:
                     gmsh.option.setNumber("General.Terminal", 0)
@@ -402,6 +416,19 @@ class ArteryMesh(unittest.TestCase):
         pts, r, wall = arc(n=30, length=6.0)
         with self.assertRaisesRegex(PatientInputError, "too thin"):
             layer_radii(r, 0.2 * wall, WallSpec(0.06, 0.065, 0.05), "c.csv")
+
+    def test_shape_quality(self):
+        """6 sqrt(2) V / l_rms^3: 1 for the regular tetrahedron at any size and position, the
+        analytic value for a flattened one, -> 0 as it flattens to a sliver."""
+        regular = np.array([[1, 1, 1], [-1, 1, -1], [1, -1, -1], [-1, -1, 1]], float)  # positively oriented
+        flat = regular * [1.0, 1.0, 0.01]  # squashed along z: V and the z edges scale
+        q = _shape_quality(np.array([regular, 3.0 * regular + 5.0, flat]))
+        np.testing.assert_allclose(q[:2], 1.0, rtol=1e-12)
+        # squashed: V = 8/3 * 0.01 (the regular one's 8/3 times the z scale), l_rms from its six edges
+        e2 = [np.sum((flat[a] - flat[b]) ** 2) for a in range(4) for b in range(a + 1, 4)]
+        expected = 6 * math.sqrt(2) * (8.0 / 3.0 * 0.01) / (np.mean(e2) ** 1.5)
+        self.assertAlmostEqual(q[2], expected, places=12)
+        self.assertLess(q[2], SLIVER_QUALITY * 3)
 
     def test_edge_table_is_gmsh_order(self):
         import gmsh
