@@ -1,6 +1,7 @@
 #include "angio/coupler/coupling_settings.hpp"
 
 #include "angio/coupler/aitken.hpp"
+#include "angio/coupler/iqn_imvj.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -23,7 +24,8 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   if (s.max_relaxation < s.initial_relaxation)
     c->child("max_relaxation").fail("a value >= coupling.initial_relaxation");
   if (auto iqn = c->optional("iqn")) {
-    if (s.acceleration != "iqn-ils") iqn->fail("no iqn section (it applies only with coupling.acceleration: iqn-ils)");
+    if (s.acceleration != "iqn-ils" && s.acceleration != "iqn-imvj")
+      iqn->fail("no iqn section (it applies only with coupling.acceleration: iqn-ils or iqn-imvj)");
     iqn->check_keys();
     s.iqn.reused_steps = iqn->get<int>("reused_steps");
     s.iqn.max_columns = iqn->get<int>("max_columns");
@@ -62,7 +64,7 @@ std::string settings_json(const CouplingSettings& s) {
                               {"prediction", s.prediction},
                               {"record", s.record},
                               {"inexact_solid", s.inexact_solid}};
-  if (s.acceleration == "iqn-ils")
+  if (s.acceleration == "iqn-ils" || s.acceleration == "iqn-imvj")
     j["iqn"] = {{"reused_steps", s.iqn.reused_steps},
                 {"max_columns", s.iqn.max_columns},
                 {"filter", s.iqn.filter},
@@ -73,6 +75,7 @@ std::string settings_json(const CouplingSettings& s) {
 std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s) {
   if (s.acceleration == "constant") return std::make_unique<ConstantRelaxation>(s.initial_relaxation);
   if (s.acceleration == "iqn-ils") return std::make_unique<IqnIls>(s.iqn);
+  if (s.acceleration == "iqn-imvj") return std::make_unique<IqnImvj>(s.iqn);
   return std::make_unique<Aitken>(s.initial_relaxation, s.max_relaxation);
 }
 

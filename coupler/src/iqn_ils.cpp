@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "angio/common/log.hpp"
+#include "filtered_qr.hpp"
 
 namespace angio::coupler {
 
@@ -33,8 +34,7 @@ Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   r_prev_ = r;
   qt_prev_ = qt;
 
-  // Collect the columns, newest first, and orthogonalize them one by one (modified Gram–Schmidt
-  // with the QR2 filter); Q holds the kept orthonormal directions, R the triangular factor.
+  // the columns, newest first, orthogonalized one by one with the QR2 filter
   std::vector<const Eigen::VectorXd*> vs, ws;
   auto take = [&](const Columns& c) {
     for (std::size_t i = 0; i < c.v.size() && int(vs.size()) < o_.max_columns; ++i)
@@ -46,38 +46,16 @@ Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   take(current_);
   for (const auto& c : previous_) take(c);
 
-  std::vector<Eigen::VectorXd> Q;
-  std::vector<int> kept;
-  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(vs.size(), vs.size());
-  for (std::size_t j = 0; j < vs.size(); ++j) {
-    Eigen::VectorXd v = *vs[j];
-    const double norm0 = v.norm();
-    if (!(norm0 > 0.0)) continue;
-    Eigen::VectorXd coeff(Q.size());
-    for (std::size_t i = 0; i < Q.size(); ++i) {
-      coeff[i] = Q[i].dot(v);
-      v -= coeff[i] * Q[i];
-    }
-    const double rest = v.norm();
-    if (rest < o_.filter * norm0) continue;  // (nearly) dependent on newer columns: drop
-    const std::size_t c = Q.size();
-    for (std::size_t i = 0; i < c; ++i) R(i, c) = coeff[i];
-    R(c, c) = rest;
-    Q.push_back(v / rest);
-    kept.push_back(int(j));
-  }
-  last_columns_ = int(Q.size());
-  if (Q.empty()) {
+  const FilteredQr qr = filtered_qr(vs, o_.filter);
+  last_columns_ = qr.size();
+  if (qr.size() == 0) {
     factor_ = o_.initial_relaxation;
     return q + factor_ * r;
   }
-  // α = argmin ||V α + r||  ⇔  R α = −Qᵀ r
-  const int m = int(Q.size());
-  Eigen::VectorXd rhs(m);
-  for (int i = 0; i < m; ++i) rhs[i] = -Q[i].dot(r);
-  const Eigen::VectorXd alpha = R.topLeftCorner(m, m).triangularView<Eigen::Upper>().solve(rhs);
+  const Eigen::VectorXd alpha = qr.least_squares(r);
+  const int m = qr.size();
   Eigen::VectorXd next = qt;
-  for (int i = 0; i < m; ++i) next += alpha[i] * *ws[kept[i]];
+  for (int i = 0; i < m; ++i) next += alpha[i] * *ws[qr.kept[i]];
   factor_ = 1.0;
   // A model step far shorter than the residual means the model claims |1 − λ| > 1/stagnation for
   // the Jacobian eigenvalue λ along r: a column pair that does not belong to this map (a column

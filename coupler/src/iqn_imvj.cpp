@@ -1,0 +1,105 @@
+#include "angio/coupler/iqn_imvj.hpp"
+
+#include <stdexcept>
+
+#include "angio/common/log.hpp"
+#include "filtered_qr.hpp"
+
+namespace angio::coupler {
+
+IqnImvj::IqnImvj(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) {
+  if (!(o_.initial_relaxation > 0.0)) throw std::invalid_argument("IQN-IMVJ: initial relaxation must be > 0");
+  if (o_.reused_steps < 0 || o_.max_columns < 1 || !(o_.filter > 0.0 && o_.filter < 1.0))
+    throw std::invalid_argument("IQN-IMVJ: need reused_steps >= 0, max_columns >= 1, 0 < filter < 1");
+  if (!(o_.stagnation >= 0.0 && o_.stagnation < 1.0)) throw std::invalid_argument("IQN-IMVJ: need 0 <= stagnation < 1");
+}
+
+void IqnImvj::begin_step() {
+  v_.clear();
+  w_.clear();
+  r_prev_.resize(0);
+  qt_prev_.resize(0);
+  last_ = Correction{};
+}
+
+void IqnImvj::restart() {
+  begin_step();
+  prev_.clear();
+}
+
+Eigen::VectorXd IqnImvj::apply_prev_(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(x.size());
+  for (const auto& c : prev_)
+    if (c.b.rows() == x.size()) y.noalias() += c.a * (c.b.transpose() * x);
+  return y;
+}
+
+Eigen::VectorXd IqnImvj::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) {
+  const Eigen::VectorXd qt = q + r;
+  if (k > 0 && r_prev_.size() == r.size()) {
+    v_.insert(v_.begin(), r - r_prev_);
+    w_.insert(w_.begin(), qt - qt_prev_);
+  }
+  r_prev_ = r;
+  qt_prev_ = qt;
+  std::vector<const Eigen::VectorXd*> vs;
+  for (std::size_t i = 0; i < v_.size() && int(vs.size()) < o_.max_columns; ++i) vs.push_back(&v_[i]);
+  const FilteredQr qr = filtered_qr(vs, o_.filter);
+  last_columns_ = qr.size();
+  const bool carried = !prev_.empty();
+  if (qr.size() == 0 && !carried) {  // nothing known yet: relax
+    factor_ = o_.initial_relaxation;
+    last_ = Correction{};
+    return q + factor_ * r;
+  }
+  Eigen::VectorXd jr = apply_prev_(r);
+  const int m = qr.size(), n = int(r.size());
+  last_ = Correction{};
+  if (m > 0) {
+    // a = (W − J_prev V) R⁻¹ over the kept columns, b = Q: J = J_prev + a bᵀ
+    Eigen::MatrixXd d(n, m), b(n, m);
+    for (int i = 0; i < m; ++i) {
+      const int j = qr.kept[i];
+      d.col(i) = w_[j] - apply_prev_(v_[j]);
+      b.col(i) = qr.q[i];
+    }
+    const auto R = qr.r.topLeftCorner(m, m).triangularView<Eigen::Upper>();
+    Eigen::MatrixXd a = R.transpose().solve(d.transpose()).transpose();  // a R = d
+    jr.noalias() += a * (b.transpose() * r);
+    // the same correction from J_prev = 0 (W R⁻¹): the first term after a restart
+    Eigen::MatrixXd wk(n, m);
+    for (int i = 0; i < m; ++i) wk.col(i) = w_[qr.kept[i]];
+    last_alone_ = R.transpose().solve(wk.transpose()).transpose();
+    last_.a = std::move(a);
+    last_.b = std::move(b);
+  }
+  const Eigen::VectorXd next = qt - jr;
+  factor_ = 1.0;
+  // as IQN-ILS: a model step far shorter than the residual does not belong to this map
+  if ((next - q).norm() < o_.stagnation * r.norm()) {
+    LOG_DEBUG("IQN-IMVJ: model step " << (next - q).norm() << " against residual " << r.norm()
+                                      << ": Jacobian dropped, relaxation " << o_.initial_relaxation);
+    v_.clear();
+    w_.clear();
+    prev_.clear();
+    last_ = Correction{};
+    ++restarts_;
+    last_columns_ = 0;
+    factor_ = o_.initial_relaxation;
+    return q + factor_ * r;
+  }
+  return next;
+}
+
+void IqnImvj::end_step(bool accepted) {
+  if (accepted && o_.reused_steps > 0 && last_.a.cols() > 0) {
+    if (int(prev_.size()) >= o_.reused_steps) {  // restart from 0 (RS-ZERO) with this step's own model
+      prev_.clear();
+      last_.a = std::move(last_alone_);
+    }
+    prev_.push_back(std::move(last_));
+  }
+  begin_step();
+}
+
+}  // namespace angio::coupler
