@@ -7,12 +7,14 @@
 
 namespace angio::coupler {
 
-IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) {
-  if (!(o_.initial_relaxation > 0.0)) throw std::invalid_argument("IQN-ILS: initial relaxation must be > 0");
-  if (o_.reused_steps < 0 || o_.max_columns < 1 || !(o_.filter > 0.0 && o_.filter < 1.0))
-    throw std::invalid_argument("IQN-ILS: need reused_steps >= 0, max_columns >= 1, 0 < filter < 1");
-  if (!(o_.stagnation >= 0.0 && o_.stagnation < 1.0)) throw std::invalid_argument("IQN-ILS: need 0 <= stagnation < 1");
+void check_iqn_options(const IqnIlsOptions& o, const std::string& method) {
+  if (!(o.initial_relaxation > 0.0)) throw std::invalid_argument(method + ": initial relaxation must be > 0");
+  if (o.reused_steps < 0 || o.max_columns < 1 || !(o.filter > 0.0 && o.filter < 1.0))
+    throw std::invalid_argument(method + ": need reused_steps >= 0, max_columns >= 1, 0 < filter < 1");
+  if (!(o.stagnation >= 0.0 && o.stagnation < 1.0)) throw std::invalid_argument(method + ": need 0 <= stagnation < 1");
 }
+
+IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) { check_iqn_options(o_, "IQN-ILS"); }
 
 void IqnIls::begin_step() {
   current_ = Columns{};

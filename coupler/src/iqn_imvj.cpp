@@ -1,18 +1,11 @@
 #include "angio/coupler/iqn_imvj.hpp"
 
-#include <stdexcept>
-
 #include "angio/common/log.hpp"
 #include "filtered_qr.hpp"
 
 namespace angio::coupler {
 
-IqnImvj::IqnImvj(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) {
-  if (!(o_.initial_relaxation > 0.0)) throw std::invalid_argument("IQN-IMVJ: initial relaxation must be > 0");
-  if (o_.reused_steps < 0 || o_.max_columns < 1 || !(o_.filter > 0.0 && o_.filter < 1.0))
-    throw std::invalid_argument("IQN-IMVJ: need reused_steps >= 0, max_columns >= 1, 0 < filter < 1");
-  if (!(o_.stagnation >= 0.0 && o_.stagnation < 1.0)) throw std::invalid_argument("IQN-IMVJ: need 0 <= stagnation < 1");
-}
+IqnImvj::IqnImvj(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) { check_iqn_options(o_, "IQN-IMVJ"); }
 
 void IqnImvj::begin_step() {
   v_.clear();

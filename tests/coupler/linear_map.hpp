@@ -8,7 +8,6 @@
 
 namespace angio::coupler::testing {
 
-
 // A map whose Gauss–Seidel iteration diverges in several modes of both signs (eigenvalues
 // −6, −2, 3, 0.5, −0.9, 4), rotated so that the modes are not the unit vectors.
 struct LinearMap {
@@ -29,7 +28,7 @@ struct LinearMap {
 
 // Runs one step; returns the number of updates until ||r|| <= tol (or -1 after max_updates).
 inline int run_step(angio::coupler::Acceleration& acc, const LinearMap& m, const Eigen::VectorXd& b, Eigen::VectorXd& q,
-             int max_updates, double tol = 1e-10) {
+                    int max_updates, double tol = 1e-10) {
   acc.begin_step();
   for (int k = 0; k <= max_updates; ++k) {
     const Eigen::VectorXd r = m.A * q + b - q;
@@ -43,6 +42,5 @@ inline int run_step(angio::coupler::Acceleration& acc, const LinearMap& m, const
   acc.end_step(false);
   return -1;
 }
-
 
 }  // namespace angio::coupler::testing

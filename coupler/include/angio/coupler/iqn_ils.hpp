@@ -16,6 +16,7 @@
 #pragma once
 
 #include <deque>
+#include <string>
 #include <vector>
 
 #include "angio/coupler/acceleration.hpp"
@@ -31,6 +32,10 @@ struct IqnIlsOptions {
   // restart when ||q_{k+1} − q_k|| < stagnation ||r_k||
   double stagnation = scene::keys::defaults::coupling_iqn_stagnation;
 };
+
+// std::invalid_argument naming `method` unless 0 < initial_relaxation, reused_steps >= 0,
+// max_columns >= 1, 0 < filter < 1 and 0 <= stagnation < 1.
+void check_iqn_options(const IqnIlsOptions& o, const std::string& method);
 
 class IqnIls : public Acceleration {
  public:

@@ -36,9 +36,9 @@ class IqnImvj : public Acceleration {
   void end_step(bool accepted) override;
   double last_factor() const override { return factor_; }
   std::string name() const override { return "iqn-imvj"; }
-  int last_columns() const { return last_columns_; }  // this step's columns in the last update
+  int last_columns() const { return last_columns_; }       // this step's columns in the last update
   int carried_steps() const { return int(prev_.size()); }  // accepted steps in J_prev
-  int restarts() const { return restarts_; }  // stagnation restarts since construction
+  int restarts() const { return restarts_; }               // stagnation restarts since construction
 
  private:
   struct Correction {
@@ -46,10 +46,10 @@ class IqnImvj : public Acceleration {
   };
   Eigen::VectorXd apply_prev_(const Eigen::VectorXd& x) const;  // J_prev x
   IqnIlsOptions o_;
-  std::vector<Correction> prev_;       // J_prev, oldest first
+  std::vector<Correction> prev_;        // J_prev, oldest first
   std::vector<Eigen::VectorXd> v_, w_;  // this step's columns, newest first
   Eigen::VectorXd r_prev_, qt_prev_;
-  Correction last_;  // the correction of the last update: J_prev's next term when the step is accepted
+  Correction last_;             // the correction of the last update: J_prev's next term when the step is accepted
   Eigen::MatrixXd last_alone_;  // last_.a as if J_prev were 0: the first term after a restart
   double factor_;
   int last_columns_ = 0;
