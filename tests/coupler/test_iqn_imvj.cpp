@@ -45,7 +45,7 @@ TEST(IqnImvj, CarriedJacobianSolvesTheNextStepWithTheFirstUpdate) {
   EXPECT_LT((q - m.fixed_point(b2)).norm(), 1e-7);
 }
 
-TEST(IqnImvj, JacobianAccumulatesOverStepsThatEachSeeFewDirections) {
+TEST(IqnImvj, RampOfStepsNeedsFewerUpdatesThanIqnIls) {
   // Ten load steps of a slowly changing b (as a pressure ramp), each from the last one's state:
   // IQN-ILS without reuse starts from nothing in every step (measured 7 updates each, the map's
   // dimension + 1); IQN-IMVJ carries the Jacobian the steps before built and needs far fewer
