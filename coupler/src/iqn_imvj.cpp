@@ -10,9 +10,11 @@ IqnImvj::IqnImvj(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) { check
 void IqnImvj::begin_step() {
   v_.clear();
   w_.clear();
+  d_.clear();
   r_prev_.resize(0);
   qt_prev_.resize(0);
   last_ = Correction{};
+  last_kept_.clear();
 }
 
 void IqnImvj::restart() {
@@ -27,11 +29,20 @@ Eigen::VectorXd IqnImvj::apply_prev_(const Eigen::VectorXd& x) const {
   return y;
 }
 
+Eigen::MatrixXd IqnImvj::times_r_inverse_(const std::vector<Eigen::VectorXd>& columns) const {
+  const int m = int(last_kept_.size());
+  Eigen::MatrixXd x(columns.front().size(), m);
+  for (int i = 0; i < m; ++i) x.col(i) = columns[last_kept_[i]];
+  // y R = x  ⇔  Rᵀ yᵀ = xᵀ
+  return last_r_.triangularView<Eigen::Upper>().transpose().solve(x.transpose()).transpose();
+}
+
 Eigen::VectorXd IqnImvj::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) {
   const Eigen::VectorXd qt = q + r;
   if (k > 0 && r_prev_.size() == r.size()) {
     v_.insert(v_.begin(), r - r_prev_);
     w_.insert(w_.begin(), qt - qt_prev_);
+    d_.insert(d_.begin(), w_.front() - apply_prev_(v_.front()));  // J_prev is fixed within the step
   }
   r_prev_ = r;
   qt_prev_ = qt;
@@ -46,25 +57,16 @@ Eigen::VectorXd IqnImvj::update(const Eigen::VectorXd& q, const Eigen::VectorXd&
     return q + factor_ * r;
   }
   Eigen::VectorXd jr = apply_prev_(r);
-  const int m = qr.size(), n = int(r.size());
+  const int m = qr.size();
   last_ = Correction{};
+  last_kept_ = qr.kept;
+  last_r_ = qr.r.topLeftCorner(m, m);
   if (m > 0) {
     // a = (W − J_prev V) R⁻¹ over the kept columns, b = Q: J = J_prev + a bᵀ
-    Eigen::MatrixXd d(n, m), b(n, m);
-    for (int i = 0; i < m; ++i) {
-      const int j = qr.kept[i];
-      d.col(i) = w_[j] - apply_prev_(v_[j]);
-      b.col(i) = qr.q[i];
-    }
-    const auto R = qr.r.topLeftCorner(m, m).triangularView<Eigen::Upper>();
-    Eigen::MatrixXd a = R.transpose().solve(d.transpose()).transpose();  // a R = d
-    jr.noalias() += a * (b.transpose() * r);
-    // the same correction from J_prev = 0 (W R⁻¹): the first term after a restart
-    Eigen::MatrixXd wk(n, m);
-    for (int i = 0; i < m; ++i) wk.col(i) = w_[qr.kept[i]];
-    last_alone_ = R.transpose().solve(wk.transpose()).transpose();
-    last_.a = std::move(a);
-    last_.b = std::move(b);
+    last_.a = times_r_inverse_(d_);
+    last_.b.resize(r.size(), m);
+    for (int i = 0; i < m; ++i) last_.b.col(i) = qr.q[i];
+    jr.noalias() += last_.a * (last_.b.transpose() * r);
   }
   const Eigen::VectorXd next = qt - jr;
   factor_ = 1.0;
@@ -74,8 +76,10 @@ Eigen::VectorXd IqnImvj::update(const Eigen::VectorXd& q, const Eigen::VectorXd&
                                       << ": Jacobian dropped, relaxation " << o_.initial_relaxation);
     v_.clear();
     w_.clear();
+    d_.clear();
     prev_.clear();
     last_ = Correction{};
+    last_kept_.clear();
     ++restarts_;
     last_columns_ = 0;
     factor_ = o_.initial_relaxation;
@@ -88,7 +92,7 @@ void IqnImvj::end_step(bool accepted) {
   if (accepted && o_.reused_steps > 0 && last_.a.cols() > 0) {
     if (int(prev_.size()) >= o_.reused_steps) {  // restart from 0 (RS-ZERO) with this step's own model
       prev_.clear();
-      last_.a = std::move(last_alone_);
+      last_.a = times_r_inverse_(w_);  // the correction from J_prev = 0: W R⁻¹, IQN-ILS's model
     }
     prev_.push_back(std::move(last_));
   }

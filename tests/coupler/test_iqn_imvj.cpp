@@ -70,17 +70,44 @@ TEST(IqnImvj, RampOfStepsNeedsFewerUpdatesThanIqnIls) {
   EXPECT_LT(mvj_total, ils_total);
 }
 
-TEST(IqnImvj, RestartsFromZeroAfterReusedSteps) {
-  LinearMap m;
+TEST(IqnImvj, RestartsFromTheLastStepsOwnModelAfterReusedSteps) {
+  // Each step another map (A scaled), so that the carried Jacobian never ends a step at once and
+  // every accepted step adds a correction: with reused_steps = 2 the carried steps go 1, 2, and the
+  // third restarts J_prev from its own model, W R⁻¹ Qᵀ, which satisfies that step's secant
+  // equations J v_i = w_i to round-off (a correction kept relative to the dropped Jacobian,
+  // (W − J_old V) R⁻¹ Qᵀ, would miss them by J_old v_i).
+  const LinearMap m;
   IqnImvj acc(IqnIlsOptions{0.1, 2, 100, 1e-10});
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+  std::vector<Eigen::VectorXd> v, w;  // the third step's differences of r and of q~ = q + r
   for (int step = 0; step < 3; ++step) {
+    const Eigen::MatrixXd A = (1.0 + 0.15 * step) * m.A;
     const Eigen::VectorXd b = Eigen::VectorXd::Constant(6, 1.0 + step);
-    // a step that needs no update adds no correction: start each away from its fixed point
-    q = Eigen::VectorXd::Zero(6);
-    ASSERT_GE(run_step(acc, m, b, q, 20, 1e-9), 0);
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(6), r_prev, qt_prev;
+    v.clear();
+    w.clear();
+    acc.begin_step();
+    bool converged = false;
+    for (int k = 0; k <= 20 && !converged; ++k) {
+      const Eigen::VectorXd r = A * q + b - q;
+      if (r.norm() <= 1e-9) {
+        acc.end_step(true);
+        converged = true;
+        break;
+      }
+      if (k > 0) {
+        v.push_back(r - r_prev);
+        w.push_back(q + r - qt_prev);
+      }
+      r_prev = r;
+      qt_prev = q + r;
+      q = acc.update(q, r, k);
+    }
+    ASSERT_TRUE(converged) << "step " << step;
+    EXPECT_EQ(acc.carried_steps(), step == 1 ? 2 : 1) << "after step " << step;
   }
-  EXPECT_EQ(acc.carried_steps(), 1);  // 1, 2, then restarted from 0 with the third step's
+  ASSERT_FALSE(v.empty());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    EXPECT_LT((acc.carried_jacobian_times(v[i]) - w[i]).norm(), 1e-8 * w[i].norm()) << "column " << i;
   acc.restart();
   EXPECT_EQ(acc.carried_steps(), 0);
 }

@@ -39,6 +39,8 @@ class IqnImvj : public Acceleration {
   int last_columns() const { return last_columns_; }       // this step's columns in the last update
   int carried_steps() const { return int(prev_.size()); }  // accepted steps in J_prev
   int restarts() const { return restarts_; }               // stagnation restarts since construction
+  // J_prev x, the Jacobian carried from the steps before (for tests and diagnostics)
+  Eigen::VectorXd carried_jacobian_times(const Eigen::VectorXd& x) const { return apply_prev_(x); }
 
  private:
   struct Correction {
@@ -46,11 +48,16 @@ class IqnImvj : public Acceleration {
   };
   Eigen::VectorXd apply_prev_(const Eigen::VectorXd& x) const;  // J_prev x
   IqnIlsOptions o_;
-  std::vector<Correction> prev_;        // J_prev, oldest first
-  std::vector<Eigen::VectorXd> v_, w_;  // this step's columns, newest first
+  std::vector<Correction> prev_;  // J_prev, oldest first
+  // this step's columns, newest first: V, W and W − J_prev V (computed once, as a column arrives)
+  std::vector<Eigen::VectorXd> v_, w_, d_;
   Eigen::VectorXd r_prev_, qt_prev_;
-  Correction last_;             // the correction of the last update: J_prev's next term when the step is accepted
-  Eigen::MatrixXd last_alone_;  // last_.a as if J_prev were 0: the first term after a restart
+  Correction last_;  // the correction of the last update: J_prev's next term when the step is accepted
+  // the last update's filtered QR of V: the kept columns and R (kept x kept)
+  std::vector<int> last_kept_;
+  Eigen::MatrixXd last_r_;
+  // the kept columns of `columns` (this step's, as v_) times R⁻¹
+  Eigen::MatrixXd times_r_inverse_(const std::vector<Eigen::VectorXd>& columns) const;
   double factor_;
   int last_columns_ = 0;
   int restarts_ = 0;
