@@ -207,6 +207,9 @@ def complete(scene, path, out_dir, log=print):
         "stent_radius": 0.5 * report["device"]["stent_crimped_outer_diameter"],
         "zeta": spline.get("smoothing", scene_keys.default("patient.balloon_spline.smoothing")),
         "margin": spline.get("clearance", scene_keys.default("patient.balloon_spline.clearance")),
+        # the scene's balloon's centre in the lumen stations (arc length along the lumen centerline),
+        # where the first phase's balloon is centred too
+        "balloon_centre_station": 0.5 * sum(report["placement"]["balloon_ends_lumen_arc_length"]),
     }
     return done, placement
 
@@ -466,11 +469,17 @@ def balloon_extent(balloon, artery):
         return None
 
 
-def treated_segment(scene, phases_, stations, stent_extent):
+def treated_segment(scene, phases_, stations, stent_extent, placed=None):
     """The stations every device of the procedure covers (the union of the balloons' and the stent's
     extents; QCA's "in-segment"), one segment for all phases so that their figures compare; None
-    (all stations) where an extent is unknown."""
-    ext = [balloon_extent(p["balloon"], scene["artery"]) for p in phases_ if p["balloon"] is not None]
+    (all stations) where an extent is unknown. placed: a patient procedure's balloon extents in the
+    stations by phase name (its devices are placed on a curved centerline, not along the tube axis)."""
+    placed = placed or {}
+    ext = [
+        placed.get(p["name"]) or balloon_extent(p["balloon"], scene["artery"])
+        for p in phases_
+        if p["balloon"] is not None
+    ]
     if stent_extent:
         ext.append(tuple(stent_extent))
     if not stations or not ext or any(e is None for e in ext):
@@ -547,9 +556,10 @@ def phase_results(pdir, phase, before, stations, mask):
     return out
 
 
-def summarize(run_dir, scene, path, ran, tools=None):
+def summarize(run_dir, scene, path, ran, tools=None, placed=None):
     """procedure.json and lumen_profiles.png from the phases that ran: [(k, phase, status, wall)];
-    tools: the virtual insertion of a phase by name (insertion_plan)."""
+    tools: the virtual insertion of a phase by name (insertion_plan); placed: a patient procedure's
+    balloon extents in the lumen stations by phase name (balloon_stations)."""
     run_dir = Path(run_dir)
     first = _load(phase_dir(run_dir, 0, ran[0][1]) / "solid" / "summary.json") if ran else None
     stations = (first or {}).get("lumen_stations") or []
@@ -579,7 +589,7 @@ def summarize(run_dir, scene, path, ran, tools=None):
         if ph["stent"]:
             last = ((_load(phase_dir(run_dir, k, ph) / "solid" / "summary.json") or {}).get("steps") or [{}])[-1]
             stent_ext = last.get("stent_stations") or stent_ext
-    mask = treated_segment(scene, [ph for _, ph, _, _ in ran], stations, stent_ext)
+    mask = treated_segment(scene, [ph for _, ph, _, _ in ran], stations, stent_ext, placed)
     out["segment"] = (
         "stations covered by the procedure's devices (balloons and stent)"
         if mask
@@ -588,6 +598,8 @@ def summarize(run_dir, scene, path, ran, tools=None):
     for k, ph, status, wall in ran:
         r = phase_results(phase_dir(run_dir, k, ph), ph, before, stations, mask)
         r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
+        if (placed or {}).get(ph["name"]):
+            r["balloon_stations"] = list(placed[ph["name"]])
         if (tools or {}).get(ph["name"]):
             r["insertion"] = {x: v for x, v in tools[ph["name"]].items() if x != "penalty"}
         out["phases"].append(r)
@@ -622,7 +634,7 @@ def run(scene, path, run_dir, launch_args, completed=None):
     run_dir = Path(run_dir)
     scene, placement = completed or complete(scene, path, run_dir / "geometry")
     ph = phases(scene, path)  # checked by the caller (check()) before the run directory exists
-    ran, previous, code, tools, placed = [], None, 0, {}, None
+    ran, previous, code, tools, placed, extents = [], None, 0, {}, None, {}
     for k, phase in enumerate(ph):
         pdir = phase_dir(run_dir, k, phase)
         scene_file = run_dir / f"{k + 1}-{phase['name']}.yaml"
@@ -652,6 +664,12 @@ def run(scene, path, run_dir, launch_args, completed=None):
         _write(
             scene_file, phase_scene(scene, phase, previous, tool, placed), f"phase {k + 1} ({phase['name']}) of {path}"
         )
+        if placement and phase["balloon"] is not None:
+            # the balloon's extent in the lumen stations: the first phase's centred on the scene's
+            # balloon (complete()), a later phase's where it was placed on the deformed lumen
+            L = float(phase["balloon"]["mesh"]["length"])
+            c = placement["balloon_centre_station"]
+            extents[phase["name"]] = ((placed or {}).get("balloon") or {}).get("stations") or (c - L / 2, c + L / 2)
         note = ", devices on the deformed lumen" if placed and placed.get("balloon") else ""
         if tool is not None:
             tools[phase["name"]] = tool
@@ -671,7 +689,7 @@ def run(scene, path, run_dir, launch_args, completed=None):
             code = rc
             break
         previous = (pdir, phase["stent"])
-    out = summarize(run_dir, scene, path, ran, tools)
+    out = summarize(run_dir, scene, path, ran, tools, extents)
     for r in out["phases"]:
         lum = r.get("lumen") or {}
         fmt = lambda v: f"{v:.3f}" if _number(v) else "-"  # noqa: E731

@@ -149,7 +149,29 @@ def _section_curves(occ, center, p, n1, n2, R, a0=0.0, a1=None):
     return rim if closed else [occ.addLine(center, q[0])] + rim + [occ.addLine(q[-1], center)]
 
 
-def _plaque_tools(occ, regions, s, P, t, n1, radii):
+# the seams of the closed sections (where their arcs meet) keep at least this angle from every
+# plaque sector's side, else the seam is turned (_seam_angle)
+SEAM_CLEARANCE = 15.0  # degrees
+
+
+def _seam_angle(regions):
+    """The angle (degrees) the closed sections of the layers and of the plaque's depth lofts start
+    at: 0 unless a plaque sector's side lies within SEAM_CLEARANCE of a seam (the four arcs of a
+    circular section meet every 90 degrees), else the angle farthest from every side. A pie side
+    lofted along a seam of the layers' lofts meets it at a grazing angle: OpenCASCADE's fragment
+    then leaves edges of a micrometre there, which gmsh meshes into slivers (shape quality 1e-5,
+    the thin cap over a lipid pool at [90, 270] degrees)."""
+    sides = [a % 90.0 for r in regions if not r.full_circle for a in r.angle]
+
+    def clearance(o):
+        return min((min(abs(o - a) % 90.0, 90.0 - abs(o - a) % 90.0) for a in sides), default=90.0)
+
+    if clearance(0.0) >= SEAM_CLEARANCE:
+        return 0.0
+    return max(np.arange(0.0, 90.0, 0.5), key=clearance)
+
+
+def _plaque_tools(occ, regions, s, P, t, n1, radii, seam=0.0):
     """The OCC solids that carve the plaque regions out of the intima, and for each region which of
     them bound it: one loft per distinct sector (from_s, to_s, angle) through pie slices from the
     centerline (closed sections for a full circle) out past the regions' depths, and one per
@@ -159,13 +181,16 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
     one sector (a fibrous cap over a lipid pool) thus share the pie's flat sides instead of bringing
     two separately lofted copies of them, which OpenCASCADE's fragment cannot merge on a curved
     centerline (overlapping facets, pieces outside the wall). The pie reaches halfway from the deepest
-    bound to the intima's outer surface, or halfway into the media when a region reaches the intima's
-    outer surface (thickness None), so that its rim coincides with no other surface. A region alone
+    bound to the intima's outer surface, or, when a region reaches the intima's outer surface
+    (thickness None), out beyond the adventitia, so that its rim coincides with no other surface
+    and cuts no layer along its thickness (a rim inside the 0.1-0.2 mm media left bands of half its
+    thickness there, meshed into slivers); the pie's pieces outside the wall are dropped. A region alone
     over its sector and at the lumen needs no depth loft: its pie's rim is its depth (a depth loft
     is closed around the vessel and would split the intima where it is thin, e.g. opposite an
     eccentric plaque, into slivers gmsh cannot mesh).
-    Returns (solids: list of dimtag lists, of_region: [(pie, inner or None, outer or None)] indices)."""
-    solids, pie_of, depth_of, of_region = [], {}, {}, []
+    Returns (solids: list of dimtag lists, of_region: [(pie, inner or None, outer or None)] indices,
+    beyond: the indices of the pies that reach outside the wall)."""
+    solids, pie_of, depth_of, of_region, beyond = [], {}, {}, [], set()
 
     def tool(key, index, build):
         if key not in index:
@@ -181,12 +206,14 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
 
         alone = len(same) == 1 and reg.offset == 0.0
 
-        def rim(lumen, i_out, m_out, deepest=deepest, to_media=to_media, alone=alone):
+        def rim(lumen, i_out, m_out, a_out, deepest=deepest, to_media=to_media, alone=alone):
             if to_media:
-                return 0.5 * (i_out + m_out)
+                return a_out + 0.5 * (a_out - m_out)
             return lumen + deepest if alone else 0.5 * (lumen + deepest + i_out)
 
         pie = tool(sector, pie_of, lambda: _sector_loft(occ, reg, s, P, t, n1, radii, rim))
+        if to_media:
+            beyond.add(pie)
         if alone:  # the pie's rim is the region's depth: no depth lofts (they would cut the whole ring)
             of_region.append((pie, None, None))
             continue
@@ -198,23 +225,23 @@ def _plaque_tools(occ, regions, s, P, t, n1, radii):
             if d is None:
                 bounds.append(None)
                 continue
-            whole = dataclasses.replace(reg, angle=(0.0, 360.0))
+            whole = dataclasses.replace(reg, angle=(seam, seam + 360.0))
             bounds.append(
                 tool(
                     (reg.from_s, reg.to_s, d),
                     depth_of,
                     lambda d=d, whole=whole: _sector_loft(
-                        occ, whole, s, P, t, n1, radii, lambda lumen, i_out, m_out: lumen + d
+                        occ, whole, s, P, t, n1, radii, lambda lumen, i_out, m_out, a_out: lumen + d
                     ),
                 )
             )
         of_region.append((pie, bounds[0], bounds[1]))
-    return solids, of_region
+    return solids, of_region, beyond
 
 
 def _sector_loft(occ, reg, s, P, t, n1, radii, radius_of):
     """The loft through the region's sections of radius radius_of(lumen, intima's outer, media's
-    outer radius) per section: closed curves for a full circle, else pie slices."""
+    outer, adventitia's outer radius) per section: closed curves for a full circle, else pie slices."""
     ss = np.concatenate([[reg.from_s], s[(s > reg.from_s + 1e-6) & (s < reg.to_s - 1e-6)], [reg.to_s]])
     Pk = np.column_stack([np.interp(ss, s, P[:, c]) for c in range(3)])
     tk = np.column_stack([np.interp(ss, s, t[:, c]) for c in range(3)])
@@ -223,7 +250,7 @@ def _sector_loft(occ, reg, s, P, t, n1, radii, radius_of):
     nk -= np.einsum("ij,ij->i", nk, tk)[:, None] * tk
     nk /= np.linalg.norm(nk, axis=1)[:, None]
     bk = np.cross(tk, nk)
-    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(3)))
+    R = radius_of(*(_interp_rows(ss, s, radii[:, j]) for j in range(4)))
     a0, a1 = (math.radians(a) for a in reg.angle)
     wires = []
     for i in range(len(ss)):
@@ -290,15 +317,18 @@ def build_artery(
         gmsh.model.add("artery")
         occ = gmsh.model.occ
         solids = []
+        seam = _seam_angle(plaque)
         for layer in range(4):
             wires = []
             for i in range(len(P)):
                 c = occ.addPoint(*P[i])
-                wires.append(occ.addWire(_section_curves(occ, c, P[i], n1[i], n2[i], radii[i, layer])))
+                wires.append(
+                    occ.addWire(_section_curves(occ, c, P[i], n1[i], n2[i], radii[i, layer], math.radians(seam)))
+                )
             vol = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
             solids.append([dt for dt in vol if dt[0] == 3])
         all_in = [dt for sl in solids for dt in sl]
-        tools, tools_of = _plaque_tools(occ, plaque, s, P, t, n1, radii)
+        tools, tools_of, beyond = _plaque_tools(occ, plaque, s, P, t, n1, radii, seam)
         flat = [(k, dt) for k, sl in enumerate(tools) for dt in sl]
         _, pieces_of = occ.fragment(all_in + [dt for _, dt in flat], [])
         occ.synchronize()
@@ -328,7 +358,9 @@ def build_artery(
             else:
                 by_layer[LAYERS[3 - k]].append(dt[1])
         outside = sorted(set(inside) - set(count))
-        if outside:  # a tool reaching beyond the outer wall: a bug of the tools' radii, not an input error
+        dropped = [dt for dt in outside if inside[dt] <= beyond]  # pies made to reach beyond the wall
+        outside = [dt for dt in outside if dt not in dropped]
+        if outside:  # another tool reaching beyond the outer wall: a bug of its radii, not an input error
             c = occ.getCenterOfMass(*outside[0])
             vol = sum(occ.getMass(*dt) for dt in outside)
             raise RuntimeError(
@@ -358,7 +390,7 @@ def build_artery(
         end1 = sorted(f for f in walls if on_plane(f, P[-1], t[-1]))
         endo = sorted((core_faces & f_int) - set(end0) - set(end1))
         outer = sorted(f_adv - f_med - set(end0) - set(end1))
-        occ.remove(core, recursive=True)
+        occ.remove(core + dropped, recursive=True)
         occ.synchronize()
         for name in groups:
             gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, by_layer[name]), name)

@@ -11,7 +11,8 @@ the scene's own when it gives one.
 Bad input refused before meshing, naming the entry: overlapping regions, a region beyond the
 centerline, thicker than the intima, a type without parameters, a bad angle.
 The same cap over a pool on a centerline bent at 10 mm: both meshed, volumes equal to the exact
-swept annular sectors (Pappus) within 1 %.
+swept annular sectors (Pappus) within 1 %; with the sector's sides on the seams of the layers'
+circular sections (90 and 270 deg), no sliver.
 With BIN_DIR: the solid alone under blood pressure on that mesh (consistency with the stiffness
 order): the calcified arc (E 8.95 MPa) stretches around the lumen (hoop Green strain) less than half
 as much as the intima beside it, and carries a larger mean first principal stress.
@@ -36,7 +37,7 @@ from patient.artery_mesh import WallSpec, layer_radii  # noqa: E402
 from patient.centerline_csv import write_centerline_csv  # noqa: E402
 from patient.errors import PatientInputError  # noqa: E402
 from patient.plaque import plaque_materials, plaque_types, read_plaque  # noqa: E402
-from patient.prepare import prepare_scene  # noqa: E402
+from patient.prepare import SLIVER_QUALITY, prepare_scene  # noqa: E402
 
 BIN = sys.argv.pop(1) if len(sys.argv) > 1 else None
 LENGTH, WALL = 6.5, 0.8
@@ -253,7 +254,7 @@ class CapOverPoolInABend(unittest.TestCase):
 
     RC = 10.0
 
-    def test_volumes(self):
+    def mesh(self, plaque):
         import meshio
 
         tmp = tempfile.mkdtemp(prefix="plaque-bend-")
@@ -262,11 +263,11 @@ class CapOverPoolInABend(unittest.TestCase):
             phi = s / self.RC  # in the x-z plane, starting along z, bending towards +x (angle 0)
             pts = np.column_stack([self.RC * (1 - np.cos(phi)), 0 * s, self.RC * np.sin(phi)])
             write_centerline_csv(os.path.join(tmp, "bent.csv"), pts, lumen_radius(s), np.full(len(s), WALL))
-            sc = scene([CAP, POOL])
+            sc = scene(plaque)
             sc["patient"]["centerline"] = "bent.csv"
             out = os.path.join(tmp, "prepared")
             os.makedirs(out)
-            prepare_scene(sc, os.path.join(tmp, "scene.yaml"), out, log=lambda m: None)
+            _, report = prepare_scene(sc, os.path.join(tmp, "scene.yaml"), out, log=lambda m: None)
             m = meshio.read(os.path.join(out, "artery.msh"))
         finally:
             shutil.rmtree(tmp)
@@ -275,10 +276,13 @@ class CapOverPoolInABend(unittest.TestCase):
         for block, phys in zip(m.cells, m.cell_data["gmsh:physical"]):
             if block.type == "tetra10":
                 vol[names[phys[0]]] = vol.get(names[phys[0]], 0.0) + tet10_volumes(m.points, block.data).sum()
+        return vol, report["artery_mesh"]
+
+    def check_volumes(self, vol, cap, pool):
         z = np.linspace(0.0, LENGTH, 6501)
         r = lumen_radius(z)
         _, ti, _, _ = layer_radii(r, np.full(len(z), WALL), WallSpec(0.06, 0.065, 0.05), "test")
-        for reg, ri, ro in ((CAP, r, r + CAP["thickness"]), (POOL, r + POOL["offset"], r + ti)):
+        for reg, ri, ro in ((cap, r, r + cap["thickness"]), (pool, r + pool["offset"], r + ti)):
             name = f"plaque_{reg['type']}"
             a0, a1 = np.radians(reg["angle"])
             on = (z >= reg["from_s"]) & (z <= reg["to_s"])
@@ -286,6 +290,22 @@ class CapOverPoolInABend(unittest.TestCase):
             exact = np.trapz(dA[on], z[on])
             print(f"{name}: meshed {vol[name]:.5f} mm^3, exact {exact:.5f} mm^3")
             self.assertAlmostEqual(vol[name] / exact, 1.0, delta=0.01, msg=f"{name}: {vol[name]:.4f} vs {exact:.4f}")
+
+    def test_volumes(self):
+        vol, _ = self.mesh([CAP, POOL])
+        self.check_volumes(vol, CAP, POOL)
+
+    def test_sides_on_the_seams_of_the_layers(self):
+        """The sector's sides at 90 and 270 deg, where the four arcs of the layers' circular sections
+        meet: the sections start elsewhere (artery_mesh._seam_angle), and no element is a sliver
+        (shape quality at least the launcher's warning level, prepare.SLIVER_QUALITY; 1e-5 when the
+        sides lay on the seams)."""
+        cap, pool = ({**reg, "angle": [90, 270]} for reg in (CAP, POOL))
+        vol, mesh = self.mesh([cap, pool])
+        print(f"shape quality per layer: {mesh['min_shape_quality']}")
+        for layer, q in mesh["min_shape_quality"].items():
+            self.assertGreater(q, SLIVER_QUALITY, f"{layer}: {q:.2e} ({mesh['worst_shape']})")
+        self.check_volumes(vol, cap, pool)
 
 
 if __name__ == "__main__":

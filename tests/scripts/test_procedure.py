@@ -141,6 +141,24 @@ class Plan(unittest.TestCase):
         # the predilatation balloon (2 mm at the artery's centre) covers stations -1 .. 1 only
         self.assertEqual(procedure.lumen_under(summary, step, s, ph[0]), 0.8)
 
+    def test_segment_of_curved_devices_from_their_placed_stations(self):
+        # a patient's balloons lie on a curved device centerline: no extent along the tube axis, so
+        # without their placed stations the segment is every station and there is no reference lumen
+        s = tiny()
+        ph = self.phases(s)
+        for p in ph:
+            if p["balloon"] is not None:
+                p["balloon"] = {"mesh": {"generator": "tube", "length": 2.0, "centerline": {"file": "c.txt"}}}
+        stations = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+        self.assertIsNone(procedure.treated_segment(s, ph, stations, None))
+        placed = {ph[0]["name"]: (2.0, 4.0), ph[1]["name"]: (1.8, 4.2), ph[2]["name"]: (2.5, 3.5)}
+        mask = procedure.treated_segment(s, ph, stations, (1.5, 4.5), placed)
+        self.assertEqual(mask, [False, False, True, True, True, False, False])
+        # the reference lumen: the first station outside the segment on either side (1 and 5 mm)
+        before = {"lumen_diameter": [3.0, 2.0, 1.0, 0.5, 1.0, 4.0, 3.0]}
+        ref = procedure.reference_area(before, mask)
+        self.assertAlmostEqual(ref, 0.5 * (math.pi * 2.0**2 / 4 + math.pi * 4.0**2 / 4))
+
 
 if __name__ == "__main__":
     unittest.main()
