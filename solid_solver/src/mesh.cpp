@@ -163,14 +163,16 @@ void Mesh::orient_surfaces() {
       const auto it = owner.find(corner_key(f.n.data(), num_corners(f.type)));
       if (it == owner.end())
         throw std::runtime_error("surface '" + s.name + "': a face is not a face of any volume element");
-      Eigen::MatrixXd Xf(f.nn(), 3);
+      // Corners only: the element's corner centroid lies strictly on its side of the plane of the
+      // face's corners (a quarter of the opposite vertex's height for a tet). With the mid-edge nodes
+      // in, a curved tri6 on a narrow lumen (1 mm elements around a 0.7 mm radius) moves the face's
+      // centroid past a thin tet's centroid and the face came out pointing into the wall: every
+      // stent point in front of it then counted as 0.1-0.3 mm deep in contact.
+      const int nc = num_corners(f.type);
       Vec3d fc = Vec3d::Zero();
-      for (int a = 0; a < f.nn(); ++a) {
-        Xf.row(a) = X[f.n[a]].transpose();
-        fc += X[f.n[a]];
-      }
-      fc /= f.nn();
-      const Vec3d A = face_area_vector(f.type, Xf);
+      for (int a = 0; a < nc; ++a) fc += X[f.n[a]] / nc;
+      const Vec3d A = nc == 3 ? Vec3d((X[f.n[1]] - X[f.n[0]]).cross(X[f.n[2]] - X[f.n[0]]))
+                              : Vec3d((X[f.n[2]] - X[f.n[0]]).cross(X[f.n[3]] - X[f.n[1]]));
       if (A.dot(fc - element_centroid(*this, it->second)) < 0) flip(f);
     }
   }

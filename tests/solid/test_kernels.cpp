@@ -293,6 +293,47 @@ TEST(Elements, PatchTestHomogeneousDeformation) {
   }
 }
 
+// A thin tet10 under a curved face, as gmsh meshes a narrow lumen coarsely (this element and face
+// are from a 1 mm mesh of the patient-like artery's 1.36 mm lesion with plaque carved into it, where
+// 15 of 430 lumen faces came out wrong): the face's mid-edge nodes bow into the wall and move the
+// six-node centroid past the element's corner centroid. orient_surfaces must still turn the face out
+// of the element: away from its fourth corner. Judged by the six-node centroid it turned the face
+// into the wall, and stent points in front of it counted as 0.1-0.3 mm deep in contact.
+TEST(Mesh, CurvedFaceOfAThinTetPointsOutOfIt) {
+  Mesh m;
+  const double x[10][3] = {{8.219162, 3.332721, 1.454312}, {8.179306, 3.380959, 1.50664},  {8.119849, 3.474949, 0.939782},
+                           {7.530878, 3.134531, 0.900369}, {8.198921, 3.357263, 1.479589}, {8.115566, 3.470217, 1.235681},
+                           {8.137649, 3.443211, 1.214865}, {7.863435, 3.267579, 1.203866}, {7.842443, 3.292725, 0.92304},
+                           {7.844935, 3.295282, 1.224847}};  // gmsh's order: edges 01 12 20 30 32 31
+  for (const auto& p : x) m.X.push_back(Vec3d(p[0], p[1], p[2]) - Vec3d(8, 3, 1));
+  Element el;
+  el.type = ElemType::Tet10;
+  for (int a = 0; a < 10; ++a) el.n[a] = a;
+  m.elements.push_back(el);
+  m.blocks.push_back({"intima", "artery"});
+  // a valid element: positive Jacobian at its Gauss points
+  Eigen::MatrixXd X(10, 3);
+  for (int a = 0; a < 10; ++a) X.row(a) = m.X[a].transpose();
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  for (const auto& q : volume_rule(ElemType::Tet10)) {
+    shape(ElemType::Tet10, q.xi, N, dN);
+    ASSERT_GT((X.transpose() * dN).determinant(), 0.0);
+  }
+  Face f;
+  f.type = FaceType::Tri6;
+  f.n = {2, 3, 0, 8, 7, 6};  // corners 2 3 0, mid-edge nodes 23 30 02, as the mesh file gives them
+  m.surfaces.push_back({"endothelium", {f}});
+  m.orient_surfaces();
+  const Face& g = m.surfaces[0].faces[0];
+  const Vec3d A = (m.X[g.n[1]] - m.X[g.n[0]]).cross(m.X[g.n[2]] - m.X[g.n[0]]);
+  const Vec3d centre = (m.X[g.n[0]] + m.X[g.n[1]] + m.X[g.n[2]]) / 3.0;
+  EXPECT_GT(A.dot(centre - m.X[1]), 0.0);  // node 1: the fourth corner
+  Eigen::MatrixXd Xf(6, 3);
+  for (int a = 0; a < 6; ++a) Xf.row(a) = m.X[g.n[a]].transpose();
+  EXPECT_GT(face_area_vector(FaceType::Tri6, Xf).dot(A), 0.0);  // the curved face turned with its corners
+}
+
 TEST(Mesh, TubeGeneratorCountsAndOrientation) {
   TubeSpec s;
   s.part = "balloon";
