@@ -12,6 +12,7 @@ conforming layers and the lumen core removed.
 Physical groups (the names the solid solver and the scene use): volumes `intima`, `media`,
 `adventitia`; surfaces `endothelium` (lumen wall), `outer`, `end0` (first station), `end1`.
 """
+import collections
 import dataclasses
 import itertools
 import math
@@ -389,7 +390,15 @@ def build_artery(
         end0 = sorted(f for f in walls if on_plane(f, P[0], t[0]))
         end1 = sorted(f for f in walls if on_plane(f, P[-1], t[-1]))
         endo = sorted((core_faces & f_int) - set(end0) - set(end1))
-        outer = sorted(f_adv - f_med - set(end0) - set(end1))
+        # a pie reaching beyond the wall cuts the adventitia into pieces: the faces between two of
+        # them bound two wall volumes and are no part of the outer surface
+        bounds = collections.Counter(
+            tag
+            for v in (v for vs in by_layer.values() for v in vs)
+            for d, tag in gmsh.model.getBoundary([(3, v)], oriented=False, combined=False)
+            if d == 2
+        )
+        outer = sorted(f for f in f_adv - f_med - set(end0) - set(end1) if bounds[f] == 1)
         occ.remove(core + dropped, recursive=True)
         occ.synchronize()
         for name in groups:
