@@ -469,14 +469,14 @@ def balloon_extent(balloon, artery):
         return None
 
 
-def treated_segment(scene, phases_, stations, stent_extent, placed=None):
+def treated_segment(scene, phases_, stations, stent_extent, balloon_stations=None):
     """The stations every device of the procedure covers (the union of the balloons' and the stent's
     extents; QCA's "in-segment"), one segment for all phases so that their figures compare; None
-    (all stations) where an extent is unknown. placed: a patient procedure's balloon extents in the
-    stations by phase name (its devices are placed on a curved centerline, not along the tube axis)."""
-    placed = placed or {}
+    (all stations) where an extent is unknown. balloon_stations: a patient procedure's balloon extents
+    in the stations by phase name (its devices lie on a curved centerline, not along the tube axis)."""
+    balloon_stations = balloon_stations or {}
     ext = [
-        placed.get(p["name"]) or balloon_extent(p["balloon"], scene["artery"])
+        balloon_stations.get(p["name"]) or balloon_extent(p["balloon"], scene["artery"])
         for p in phases_
         if p["balloon"] is not None
     ]
@@ -556,10 +556,10 @@ def phase_results(pdir, phase, before, stations, mask):
     return out
 
 
-def summarize(run_dir, scene, path, ran, tools=None, placed=None):
+def summarize(run_dir, scene, path, ran, tools=None, balloon_stations=None):
     """procedure.json and lumen_profiles.png from the phases that ran: [(k, phase, status, wall)];
-    tools: the virtual insertion of a phase by name (insertion_plan); placed: a patient procedure's
-    balloon extents in the lumen stations by phase name (balloon_stations)."""
+    tools: the virtual insertion of a phase by name (insertion_plan); balloon_stations: a patient
+    procedure's balloon extents in the lumen stations by phase name."""
     run_dir = Path(run_dir)
     first = _load(phase_dir(run_dir, 0, ran[0][1]) / "solid" / "summary.json") if ran else None
     stations = (first or {}).get("lumen_stations") or []
@@ -589,7 +589,7 @@ def summarize(run_dir, scene, path, ran, tools=None, placed=None):
         if ph["stent"]:
             last = ((_load(phase_dir(run_dir, k, ph) / "solid" / "summary.json") or {}).get("steps") or [{}])[-1]
             stent_ext = last.get("stent_stations") or stent_ext
-    mask = treated_segment(scene, [ph for _, ph, _, _ in ran], stations, stent_ext, placed)
+    mask = treated_segment(scene, [ph for _, ph, _, _ in ran], stations, stent_ext, balloon_stations)
     out["segment"] = (
         "stations covered by the procedure's devices (balloons and stent)"
         if mask
@@ -598,8 +598,8 @@ def summarize(run_dir, scene, path, ran, tools=None, placed=None):
     for k, ph, status, wall in ran:
         r = phase_results(phase_dir(run_dir, k, ph), ph, before, stations, mask)
         r.update({"status": status, "wall_seconds": round(wall, 1), "run_dir": str(phase_dir(run_dir, k, ph))})
-        if (placed or {}).get(ph["name"]):
-            r["balloon_stations"] = list(placed[ph["name"]])
+        if (balloon_stations or {}).get(ph["name"]):
+            r["balloon_stations"] = list(balloon_stations[ph["name"]])
         if (tools or {}).get(ph["name"]):
             r["insertion"] = {x: v for x, v in tools[ph["name"]].items() if x != "penalty"}
         out["phases"].append(r)

@@ -372,11 +372,11 @@ def build_artery(
             empty = [name for name, v in by_layer.items() if not v]
             raise RuntimeError(f"gmsh fragment did not give three nested layers and the plaque (empty: {empty})")
 
+        def boundary(v):
+            return [tag for d, tag in gmsh.model.getBoundary([(3, v)], oriented=False, combined=False) if d == 2]
+
         def faces(vols):
-            out = set()
-            for v in vols:
-                out.update(tag for d, tag in gmsh.model.getBoundary([(3, v)], oriented=False, combined=False) if d == 2)
-            return out
+            return {tag for v in vols for tag in boundary(v)}
 
         core_faces = faces([c[1] for c in core])
         f_int, f_med, f_adv = (faces(by_layer[n]) for n in LAYERS)
@@ -392,12 +392,7 @@ def build_artery(
         endo = sorted((core_faces & f_int) - set(end0) - set(end1))
         # a pie reaching beyond the wall cuts the adventitia into pieces: the faces between two of
         # them bound two wall volumes and are no part of the outer surface
-        bounds = collections.Counter(
-            tag
-            for v in (v for vs in by_layer.values() for v in vs)
-            for d, tag in gmsh.model.getBoundary([(3, v)], oriented=False, combined=False)
-            if d == 2
-        )
+        bounds = collections.Counter(tag for vs in by_layer.values() for v in vs for tag in boundary(v))
         outer = sorted(f for f in f_adv - f_med - set(end0) - set(end1) if bounds[f] == 1)
         occ.remove(core + dropped, recursive=True)
         occ.synchronize()
