@@ -64,7 +64,8 @@ int main(int argc, char** argv) {
       return 2;
     }
     {  // PETSc's own types and packages: a refused option is bad input, before anything runs
-      const auto pc = angio::solid::check_petsc_options(scene.options.petsc_options);
+      const auto pc =
+          angio::solid::check_petsc_options(scene.options.petsc_options, angio::solid::part_names(scene.mesh));
       if (!pc.error.empty()) {
         if (rank == 0)
           LOG_ERROR(cli.get("scene") << ": solid.petsc_options: expected options PETSc accepts, got \""

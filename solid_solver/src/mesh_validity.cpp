@@ -1,6 +1,7 @@
 // Reference-configuration validity of a mesh: the Jacobian determinant of the isoparametric map
 // must be positive wherever the element is integrated and at its nodes. A curved tet10 can be
 // positive at every Gauss point and still fold at a corner, so both are checked.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -52,6 +53,13 @@ std::string first_invalid_element(const Mesh& m) {
 }  // namespace angio::solid
 
 namespace angio::solid {
+
+std::vector<std::string> part_names(const Mesh& mesh) {
+  std::vector<std::string> names;
+  for (const auto& b : mesh.blocks)
+    if (std::find(names.begin(), names.end(), b.part) == names.end()) names.push_back(b.part);
+  return names;
+}
 
 std::string block_names(const Mesh& m) {
   std::string s;

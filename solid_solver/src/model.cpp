@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "angio/solid/petsc_options_check.hpp"
 #include "petsc_check.hpp"
 
 namespace angio::solid {
@@ -208,55 +209,72 @@ void SolidModel::partition_() {
     if (elem_rank_[e] == rank_) local_elements_.push_back(e);
 }
 
-void SolidModel::setup_petsc_() {
-  const int nn = int(mesh_.X.size()), nloc = node_end_ - node_begin_;
-  // node adjacency of owned nodes -> block preallocation
-  std::vector<std::vector<int>> nbr(nloc);
-  for (const auto& el : mesh_.elements) {
-    for (int a = 0; a < el.nn(); ++a) {
-      const int pa = perm_[el.n[a]];
+void SolidModel::set_contact(ContactModel* contact) {
+  contact_ = contact;
+  if (!contact) return;
+  const std::vector<NodeCoupling> extra = contact->couplings(*this);
+  if (!extra.empty()) create_matrix_(extra);
+}
+
+void SolidModel::create_matrix_(const std::vector<NodeCoupling>& extra) {
+  const int nloc = node_end_ - node_begin_;
+  // column nodes (new numbering) of each owned row node
+  std::vector<std::vector<PetscInt>> nbr(nloc);
+  auto couple = [&](const int* rows, int nr, const int* cols, int nc) {
+    for (int a = 0; a < nr; ++a) {
+      const int pa = perm_[rows[a]];
       if (pa < node_begin_ || pa >= node_end_) continue;
       auto& v = nbr[pa - node_begin_];
-      for (int b = 0; b < el.nn(); ++b) v.push_back(perm_[el.n[b]]);
+      for (int b = 0; b < nc; ++b) v.push_back(perm_[cols[b]]);
     }
-  }
+  };
+  for (const auto& el : mesh_.elements) couple(el.n.data(), el.nn(), el.n.data(), el.nn());
+  for (const auto& c : extra) couple(c.rows.data(), int(c.rows.size()), c.cols.data(), int(c.cols.size()));
   std::vector<PetscInt> dnnz(nloc), onnz(nloc);
+  size_t widest = 0;
   for (int i = 0; i < nloc; ++i) {
     auto& v = nbr[i];
+    v.push_back(node_begin_ + i);  // the diagonal, also of a node in no element
     std::sort(v.begin(), v.end());
     v.erase(std::unique(v.begin(), v.end()), v.end());
-    if (v.empty()) v.push_back(node_begin_ + i);
+    widest = std::max(widest, v.size());
     int d = 0;
-    for (int j : v) d += (j >= node_begin_ && j < node_end_);
+    for (PetscInt j : v) d += (j >= node_begin_ && j < node_end_);
     dnnz[i] = d;
     onnz[i] = PetscInt(v.size()) - d;
   }
+  if (K_) MatDestroy(&K_);
   ANGIO_PETSC(MatCreate(comm_, &K_));
-  ANGIO_PETSC(MatSetSizes(K_, 3 * nloc, 3 * nloc, 3 * nn, 3 * nn));
+  ANGIO_PETSC(MatSetSizes(K_, 3 * nloc, 3 * nloc, num_dofs(), num_dofs()));
   ANGIO_PETSC(MatSetType(K_, MATAIJ));
   ANGIO_PETSC(MatSetBlockSize(K_, 3));
   ANGIO_PETSC(MatXAIJSetPreallocation(K_, 3, dnnz.data(), onnz.data(), nullptr, nullptr));
-  ANGIO_PETSC(MatSetOption(K_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));  // contact may add entries
+  // an entry outside the pattern is still accepted (at the price of a reallocation), not an error
+  ANGIO_PETSC(MatSetOption(K_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
   ANGIO_PETSC(MatSetOption(K_, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
   ANGIO_PETSC(MatSetOption(K_, MAT_ROW_ORIENTED, PETSC_FALSE));  // Eigen is column-major
+  // the whole pattern inserted once: the first assembly would otherwise squeeze out what it did not touch
+  const std::vector<PetscScalar> zeros(9 * widest, 0.0);
+  for (int i = 0; i < nloc; ++i) {
+    const PetscInt row = node_begin_ + i;
+    ANGIO_PETSC(MatSetValuesBlocked(K_, 1, &row, PetscInt(nbr[i].size()), nbr[i].data(), zeros.data(), INSERT_VALUES));
+  }
+  ANGIO_PETSC(MatAssemblyBegin(K_, MAT_FINAL_ASSEMBLY));
+  ANGIO_PETSC(MatAssemblyEnd(K_, MAT_FINAL_ASSEMBLY));
+  // rigid-body near null space (for GAMG; harmless otherwise)
+  std::vector<PetscInt> owned(nloc);
+  std::iota(owned.begin(), owned.end(), node_begin_);
+  MatNullSpace nsp = rigid_body_modes_(owned);
+  ANGIO_PETSC(MatSetNearNullSpace(K_, nsp));
+  MatNullSpaceDestroy(&nsp);
+  if (ksp_) ANGIO_PETSC(KSPSetOperators(ksp_, K_, K_));
+  pc_current_ = false;
+}
+
+void SolidModel::setup_petsc_() {
+  create_matrix_({});
   ANGIO_PETSC(MatCreateVecs(K_, &du_, &r_));
   ANGIO_PETSC(VecSetBlockSize(du_, 3));
-  // rigid-body near null space (for GAMG; harmless otherwise)
-  {
-    Vec coords;
-    ANGIO_PETSC(VecDuplicate(du_, &coords));
-    ANGIO_PETSC(VecSetBlockSize(coords, 3));
-    PetscScalar* c;
-    ANGIO_PETSC(VecGetArray(coords, &c));
-    for (int i = node_begin_; i < node_end_; ++i)
-      for (int k = 0; k < 3; ++k) c[3 * (i - node_begin_) + k] = mesh_.X[iperm_[i]](k);
-    ANGIO_PETSC(VecRestoreArray(coords, &c));
-    MatNullSpace nsp;
-    ANGIO_PETSC(MatNullSpaceCreateRigidBody(coords, &nsp));
-    ANGIO_PETSC(MatSetNearNullSpace(K_, nsp));
-    MatNullSpaceDestroy(&nsp);
-    VecDestroy(&coords);
-  }
   ANGIO_PETSC(VecScatterCreateToAll(du_, &scatter_, &full_));
   ANGIO_PETSC(PetscOptionsCreate(&options_));
   ANGIO_PETSC(PetscOptionsInsertString(options_, petsc_default_options()));
@@ -265,6 +283,57 @@ void SolidModel::setup_petsc_() {
   ANGIO_PETSC(KSPCreate(comm_, &ksp_));
   ANGIO_PETSC(KSPSetOperators(ksp_, K_, K_));
   ANGIO_PETSC(KSPSetFromOptions(ksp_));
+  PC pc;
+  ANGIO_PETSC(KSPGetPC(ksp_, &pc));
+  PetscBool split = PETSC_FALSE;
+  ANGIO_PETSC(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &split));
+  if (split) set_part_splits_(pc);
+}
+
+std::vector<std::string> SolidModel::unused_petsc_options() const {
+  return solid::unused_petsc_options(options_, opt_.petsc_options);
+}
+
+MatNullSpace SolidModel::rigid_body_modes_(const std::vector<PetscInt>& nodes) const {
+  Vec coords;
+  ANGIO_PETSC(VecCreateMPI(comm_, 3 * PetscInt(nodes.size()), PETSC_DECIDE, &coords));
+  ANGIO_PETSC(VecSetBlockSize(coords, 3));
+  PetscScalar* c;
+  ANGIO_PETSC(VecGetArray(coords, &c));
+  for (size_t i = 0; i < nodes.size(); ++i)
+    for (int k = 0; k < 3; ++k) c[3 * i + k] = mesh_.X[iperm_[nodes[i]]](k);
+  ANGIO_PETSC(VecRestoreArray(coords, &c));
+  MatNullSpace nsp;
+  ANGIO_PETSC(MatNullSpaceCreateRigidBody(coords, &nsp));
+  VecDestroy(&coords);
+  return nsp;
+}
+
+void SolidModel::set_part_splits_(PC pc) {
+  // One split per part of the mesh (Block::part: "balloon", "artery"), named after it, so that each
+  // body takes its own preconditioner from the options (-fieldsplit_artery_pc_type gamg,
+  // -fieldsplit_balloon_pc_type lu, ...): the bodies are coupled only by the contact penalty, and an
+  // algebraic multigrid that serves the artery's tet10 wall is slowed by the balloon's thin,
+  // strongly anisotropic membrane (docs/performance.md). Each split carries its own rigid-body near
+  // null space (PCFIELDSPLIT hands an IS's "nearnullspace" to its block).
+  const std::vector<std::string> parts = part_names(mesh_);
+  std::vector<int> node_part(mesh_.X.size(), 0);  // a node in no element: the first part's split
+  for (const auto& el : mesh_.elements) {
+    const int k = int(std::find(parts.begin(), parts.end(), mesh_.blocks[el.block].part) - parts.begin());
+    for (int a = 0; a < el.nn(); ++a) node_part[el.n[a]] = k;
+  }
+  for (int k = 0; k < int(parts.size()); ++k) {
+    std::vector<PetscInt> nodes;
+    for (int i = node_begin_; i < node_end_; ++i)
+      if (node_part[iperm_[i]] == k) nodes.push_back(i);
+    IS is;
+    ANGIO_PETSC(ISCreateBlock(comm_, 3, PetscInt(nodes.size()), nodes.data(), PETSC_COPY_VALUES, &is));
+    MatNullSpace nsp = rigid_body_modes_(nodes);
+    ANGIO_PETSC(PetscObjectCompose((PetscObject)is, "nearnullspace", (PetscObject)nsp));
+    ANGIO_PETSC(PCFieldSplitSetIS(pc, parts[k].c_str(), is));
+    MatNullSpaceDestroy(&nsp);
+    ISDestroy(&is);
+  }
 }
 
 std::vector<Face> SolidModel::owned_faces_(const std::string& name, const char* what) const {

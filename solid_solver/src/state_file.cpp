@@ -34,13 +34,6 @@ const PartState* StateFile::part(const std::string& name) const {
   return nullptr;
 }
 
-std::vector<std::string> part_names(const Mesh& mesh) {
-  std::vector<std::string> names;
-  for (const auto& b : mesh.blocks)
-    if (std::find(names.begin(), names.end(), b.part) == names.end()) names.push_back(b.part);
-  return names;
-}
-
 std::vector<int> part_elements(const Mesh& mesh, const std::string& part) {
   std::vector<int> elems;
   for (size_t e = 0; e < mesh.elements.size(); ++e)

@@ -153,6 +153,27 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   timing_.seconds += MPI_Wtime() - t0;
 }
 
+std::vector<NodeCoupling> PenaltyStentContact::couplings(const SolidModel& model) const {
+  std::vector<NodeCoupling> out;
+  if (!opt_.averaged_normals) return out;
+  std::vector<std::vector<int>> ring(model.mesh().X.size());  // as contact::nodal_normals builds them
+  for (const auto& surface : surfaces_) {
+    for (auto& r : ring) r.clear();
+    for (const auto& f : surface->faces)
+      for (int a = 0; a < f.nn(); ++a)
+        ring[f.nodes[a]].insert(ring[f.nodes[a]].end(), f.nodes.begin(), f.nodes.begin() + f.nn());
+    for (const auto& f : surface->faces) {
+      NodeCoupling c;
+      c.rows.assign(f.nodes.begin(), f.nodes.begin() + f.nn());
+      for (int a = 0; a < f.nn(); ++a) c.cols.insert(c.cols.end(), ring[f.nodes[a]].begin(), ring[f.nodes[a]].end());
+      std::sort(c.cols.begin(), c.cols.end());
+      c.cols.erase(std::unique(c.cols.begin(), c.cols.end()), c.cols.end());
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
 void PenaltyStentContact::fill_reply(const SolidModel& model, participant::ContactReply& reply) {
   const size_t n = points_.size();
   if (reply.line_loads.size() != n)
@@ -265,6 +286,15 @@ void CompositeContact::set_points(const participant::SamplePoints& points) {
 void CompositeContact::add(const SolidModel& model, Vec r, Mat K) {
   if (stent_) stent_->add(model, r, K);
   for (auto* m : others_) m->add(model, r, K);
+}
+
+std::vector<NodeCoupling> CompositeContact::couplings(const SolidModel& model) const {
+  std::vector<NodeCoupling> out = stent_ ? stent_->couplings(model) : std::vector<NodeCoupling>{};
+  for (auto* m : others_) {
+    auto c = m->couplings(model);
+    out.insert(out.end(), std::make_move_iterator(c.begin()), std::make_move_iterator(c.end()));
+  }
+  return out;
 }
 
 void CompositeContact::fill_reply(const SolidModel& model, participant::ContactReply& reply) {

@@ -12,6 +12,7 @@
 #include "angio/solid/contact_scene.hpp"
 #include "angio/solid/model.hpp"
 #include "angio/solid/participant.hpp"
+#include "angio/solid/petsc_options_check.hpp"
 #include "angio/solid/scene.hpp"
 #include "angio/solid/stent_contact.hpp"
 #include "mpi_test.hpp"
@@ -277,6 +278,34 @@ void check_model_tangent(bool averaged_normals) {
 TEST(StentContact, TangentMatchesFiniteDifferences) { check_model_tangent(false); }
 TEST(StentContact, TangentMatchesFiniteDifferencesAveragedNormals) { check_model_tangent(true); }
 
+// (3) The couplings of the averaged normals' rings are part of the matrix's pattern before the first
+// contact assembly: inserting the tangent of active points allocates nothing (a PETSc AIJ matrix copies
+// itself for every entry outside its pattern). Consistency property of the assembly, on 1 and 2 ranks:
+// without PenaltyStentContact::couplings() the rings (4 x 4 surface nodes around a quad4 face) reach
+// past the hex8 elements' pattern and the count is positive.
+TEST(StentContact, AveragedNormalsTangentFitsThePattern) {
+  Mesh m = tube("balloon", 0.44, 0.04, 1.2, 10, 3);
+  SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 1.0, 0.3)}, tight_options());
+  participant::SamplePoints pts;
+  const auto& faces = model.mesh().surface("balloon_outer")->faces;
+  for (int k : {3, 14, 22}) {
+    pts.x.push_back(pressed_point(model.mesh(), faces[k], 0.06, 0.005));
+    pts.w.push_back(0.07);
+    pts.radius.push_back(0.06);
+  }
+  PenaltyStentContact::Options so;
+  so.balloon_penalty = 10.0;
+  so.averaged_normals = true;
+  PenaltyStentContact stent(model, so);
+  model.set_contact(&stent);
+  stent.set_points(pts);
+  ASSERT_TRUE(model.assemble(model.residual_vector(), model.matrix()));
+  EXPECT_EQ(stent.last().num_active, 3);
+  MatInfo info;
+  MatGetInfo(model.matrix(), MAT_GLOBAL_SUM, &info);
+  EXPECT_EQ(info.mallocs, 0.0);
+}
+
 // Cost of the stent contact in an assembly (printed): 1260 sample points (4-ring stent: 210 elements x 6) on a
 // helix pressing 2 um into the paper's balloon (22 x 58 hex8); compared with the whole assembly (elements +
 // contact) of the same model. No physical reference; checks that every point is active and the forces balance.
@@ -323,11 +352,13 @@ struct BAResult {
   bool converged = true;
   double max_u = 0, force = 0, force_magnitude = 0, min_gap = 0, area = 0;
   int active = 0;
+  std::vector<std::string> unused;  // petsc options no solver object asked for
 };
-BAResult balloon_artery_run(MPI_Comm comm) {
+BAResult balloon_artery_run(MPI_Comm comm, const std::string& petsc_options = "") {
   Mesh m = tube("balloon", 0.46, 0.04, 2.0, 16, 8);
   m.append(tube("artery", 0.55, 0.2, 2.6, 12, 7));
   ModelOptions o = tight_options();
+  o.petsc_options += " " + petsc_options;
   o.newton.rtol = 1e-10;
   o.newton.atol = 1e-11;
   SolidModel model(comm, m, {neo_hooke("balloon", 1.0, 0.3), neo_hooke("artery", 0.1, 0.3)}, o);
@@ -354,6 +385,7 @@ BAResult balloon_artery_run(MPI_Comm comm) {
   res.min_gap = ba.last().min_gap;
   res.active = ba.last().num_active;
   res.area = ba.active_area();
+  res.unused = model.unused_petsc_options();
   return res;
 }
 }  // namespace
@@ -380,6 +412,31 @@ TEST(BalloonArtery, ConvergesAndMatchesOnOneAndTwoRanks) {
     EXPECT_NEAR(a.min_gap, v[2], 1e-6 * std::abs(v[2]));
     EXPECT_EQ(a.active, int(v[3]));
   }
+}
+
+// -pc_type fieldsplit: one split per part, named after it (the balloon by LU, the artery by GAMG with
+// its rigid-body modes), the two coupled through the contact by GMRES. Consistency property: the same
+// converged state as the default solver's; and the options check knows the splits' names.
+TEST(BalloonArtery, SplitsByPartGiveTheSameState) {
+  const BAResult a = balloon_artery_run(PETSC_COMM_WORLD);
+  const char* split =
+      "-ksp_type gmres -ksp_gmres_restart 100 -pc_type fieldsplit -pc_fieldsplit_type multiplicative "
+      "-fieldsplit_balloon_ksp_type preonly -fieldsplit_balloon_pc_type lu "
+      "-fieldsplit_artery_ksp_type preonly -fieldsplit_artery_pc_type gamg";
+  const BAResult b = balloon_artery_run(PETSC_COMM_WORLD, split);
+  ASSERT_TRUE(a.converged);
+  ASSERT_TRUE(b.converged);
+  EXPECT_NEAR(b.max_u, a.max_u, 1e-7 * a.max_u);
+  EXPECT_NEAR(b.force_magnitude, a.force_magnitude, 1e-6 * a.force_magnitude);
+  EXPECT_EQ(b.active, a.active);
+  EXPECT_TRUE(b.unused.empty()) << b.unused.front();  // each split's options reached its solver
+  const auto ok = check_petsc_options(split, {"balloon", "artery"});
+  EXPECT_EQ(ok.error, "");
+  EXPECT_TRUE(ok.unused.empty());
+  const auto typo =
+      check_petsc_options(std::string(split) + " -fieldsplit_arteri_pc_type jacobi", {"balloon", "artery"});
+  EXPECT_EQ(typo.error, "");
+  EXPECT_EQ(typo.unused, std::vector<std::string>{"-fieldsplit_arteri_pc_type"});
 }
 
 // Scene section validation: defaults, `off`, typos named with their key path.

@@ -130,6 +130,8 @@ std::string first_invalid_element(const Mesh& m);
 // "a, b, c": the names of the mesh's blocks or surface sets (the latter without `prefix`), for
 // messages that name what a mesh does have.
 std::string block_names(const Mesh& m);
+// The mesh's parts (Block::part), in the order of their first block.
+std::vector<std::string> part_names(const Mesh& m);
 std::string surface_names(const Mesh& m, const std::string& prefix);
 
 }  // namespace angio::solid

@@ -3,6 +3,8 @@
 // mesh is built and the coupled processes have started.
 #pragma once
 
+#include <petscsys.h>
+
 #include <string>
 #include <vector>
 
@@ -13,8 +15,14 @@ struct PetscOptionsCheck {
   std::vector<std::string> unused;  // options of `options` no object asked for (typos, or for other objects)
 };
 
-// Sets up and runs a KSP with petsc_default_options() and then `options` on a 2x2 system (this rank
-// only, PETSC_COMM_SELF; PETSc initialized). Never throws for a refused option.
-PetscOptionsCheck check_petsc_options(const std::string& options);
+// Sets up and runs a KSP with petsc_default_options() and then `options` on a small system (this
+// rank only, PETSC_COMM_SELF; PETSc initialized), two unknowns per name of `parts` (the mesh's parts,
+// Block::part): with -pc_type fieldsplit each part is a split named after it, as SolidModel defines
+// them, so that the options of each split (-fieldsplit_artery_pc_type ...) are tried too. Never throws
+// for a refused option.
+PetscOptionsCheck check_petsc_options(const std::string& options, const std::vector<std::string>& parts = {});
+
+// The options named in `options` that nothing has queried from the database `o` (null: none).
+std::vector<std::string> unused_petsc_options(PetscOptions o, const std::string& options);
 
 }  // namespace angio::solid

@@ -48,7 +48,6 @@ struct StateFile {
 // Nodes (ascending) and elements (ascending) of the blocks whose part is `part`.
 std::vector<int> part_nodes(const Mesh& mesh, const std::string& part);
 std::vector<int> part_elements(const Mesh& mesh, const std::string& part);
-std::vector<std::string> part_names(const Mesh& mesh);  // in the order of their first block
 
 // Collective: the committed state of every part of the model into `path` (rank 0 writes).
 void write_state_file(SolidModel& model, const std::string& path, int step);

@@ -72,6 +72,9 @@ class PenaltyStentContact : public StentContact {
 
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
+  // With averaged normals a point's tangent couples its face's nodes with the rings of their normals
+  // (the nodes of the faces around each); without, it stays within the face (an element's pattern).
+  std::vector<NodeCoupling> couplings(const SolidModel& model) const override;
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
@@ -141,6 +144,7 @@ class CompositeContact : public StentContact {
   void add_model(ContactModel* m) { others_.push_back(m); }
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
+  std::vector<NodeCoupling> couplings(const SolidModel& model) const override;  // of all its models
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
