@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import second_order
 from .centerline_csv import arc_length
 from .errors import PatientInputError
 
@@ -416,7 +417,7 @@ def build_artery(
         if seeds:  # the field's seed points are no part of the artery: their nodes go, the rest renumbered
             gmsh.model.mesh.clear(seeds)
             gmsh.model.mesh.renumberNodes()
-        gmsh.model.mesh.setOrder(2)  # tet10 / tri6 on the curved geometry
+        second_order.set_order_two()  # tet10 / tri6 on the curved geometry (gmsh's setOrder: minutes)
         samples = _jacobian_samples()
         if samples[2].size and samples[2].min() <= 0.0:
             # a mid-edge node pulled onto the curved boundary can invert a thin element: untangle

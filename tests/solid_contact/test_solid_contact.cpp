@@ -185,6 +185,18 @@ solid:
   runner.end_step(true);
 }
 
+// Three stent points (radius 0.06 mm) pressed 5 um into faces 3, 14 and 22 of the balloon's outer surface.
+participant::SamplePoints pressed_into_balloon(const Mesh& m) {
+  participant::SamplePoints pts;
+  const auto& faces = m.surface("balloon_outer")->faces;
+  for (int k : {3, 14, 22}) {
+    pts.x.push_back(pressed_point(m, faces[k], 0.06, 0.005));
+    pts.w.push_back(0.07);
+    pts.radius.push_back(0.06);
+  }
+  return pts;
+}
+
 // (2) The assembled tangent of the model (elements + stent line contact + balloon-artery surface contact, through
 // ContactModel::add into the model's PETSc Mat, including the new balloon-artery couplings) compared with
 // central finite differences of the assembled residual; with closest-point and with averaged normals (the latter
@@ -194,13 +206,7 @@ void check_model_tangent(bool averaged_normals) {
   m.append(tube("artery", 0.47, 0.1, 1.6, 8, 3));  // balloon outer radius 0.48 > artery inner radius 0.47
   SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 1.0, 0.3), neo_hooke("artery", 0.5, 0.3)},
                    tight_options());
-  participant::SamplePoints pts;
-  const auto& faces = model.mesh().surface("balloon_outer")->faces;
-  for (int k : {3, 14, 22}) {
-    pts.x.push_back(pressed_point(model.mesh(), faces[k], 0.06, 0.005));
-    pts.w.push_back(0.07);
-    pts.radius.push_back(0.06);
-  }
+  const participant::SamplePoints pts = pressed_into_balloon(model.mesh());
   PenaltyStentContact::Options so;
   so.balloon_penalty = 10.0;
   so.artery_penalty = 8.0;
@@ -286,13 +292,7 @@ TEST(StentContact, TangentMatchesFiniteDifferencesAveragedNormals) { check_model
 TEST(StentContact, AveragedNormalsTangentFitsThePattern) {
   Mesh m = tube("balloon", 0.44, 0.04, 1.2, 10, 3);
   SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 1.0, 0.3)}, tight_options());
-  participant::SamplePoints pts;
-  const auto& faces = model.mesh().surface("balloon_outer")->faces;
-  for (int k : {3, 14, 22}) {
-    pts.x.push_back(pressed_point(model.mesh(), faces[k], 0.06, 0.005));
-    pts.w.push_back(0.07);
-    pts.radius.push_back(0.06);
-  }
+  const participant::SamplePoints pts = pressed_into_balloon(model.mesh());
   PenaltyStentContact::Options so;
   so.balloon_penalty = 10.0;
   so.averaged_normals = true;
