@@ -20,9 +20,10 @@ import scipy.sparse.csgraph
 from .errors import PatientInputError
 
 ANGLES = 48  # samples per section: 7.5 degrees apart, below the artery mesh's element size around
-# The loft's splines go through fewer points: gmsh's second-order pass (projecting mid-edge nodes onto
-# the lofted spline surfaces) grows with their poles: measured on an elliptic tube, mesh size 0.8 mm,
-# 4.3k tet10, beside a run, setOrder took 176 s with 48 points, 31 s with 16 (circles: 7 s).
+# The loft's splines go through fewer points: OpenCASCADE's work on the lofted spline surfaces grows
+# with their poles. Measured on an elliptic tube, mesh size 0.8 mm, 4.3k tet10, beside a run, with
+# gmsh's own second-order pass (projections onto the lofts, since replaced by second_order.py):
+# 176 s with 48 points, 31 s with 16 (circles: 7 s); the fragment's share not measured apart.
 SPLINE_POINTS = 16
 
 
