@@ -417,7 +417,9 @@ def build_artery(
         if seeds:  # the field's seed points are no part of the artery: their nodes go, the rest renumbered
             gmsh.model.mesh.clear(seeds)
             gmsh.model.mesh.renumberNodes()
-        second_order.set_order_two()  # tet10 / tri6 on the curved geometry (gmsh's setOrder: minutes)
+        _, off_geometry = second_order.set_order_two()  # tet10 / tri6 on the curved geometry
+        if off_geometry:
+            log(f"patient: {off_geometry} mid-edge nodes of the boundary left on their chords (no close point found)")
         samples = _jacobian_samples()
         if samples[2].size and samples[2].min() <= 0.0:
             # a mid-edge node pulled onto the curved boundary can invert a thin element: untangle

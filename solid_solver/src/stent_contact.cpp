@@ -8,6 +8,7 @@
 #include <span>
 #include <stdexcept>
 
+#include "angio/contact/normal_field.hpp"
 #include "angio/solid/model.hpp"
 #include "petsc_check.hpp"
 
@@ -156,12 +157,8 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
 std::vector<NodeCoupling> PenaltyStentContact::couplings(const SolidModel& model) const {
   std::vector<NodeCoupling> out;
   if (!opt_.averaged_normals) return out;
-  std::vector<std::vector<int>> ring(model.mesh().X.size());  // as contact::nodal_normals builds them
   for (const auto& surface : surfaces_) {
-    for (auto& r : ring) r.clear();
-    for (const auto& f : surface->faces)
-      for (int a = 0; a < f.nn(); ++a)
-        ring[f.nodes[a]].insert(ring[f.nodes[a]].end(), f.nodes.begin(), f.nodes.begin() + f.nn());
+    const auto ring = contact::node_rings(*surface, model.mesh().X.size());
     for (const auto& f : surface->faces) {
       NodeCoupling c;
       c.rows.assign(f.nodes.begin(), f.nodes.begin() + f.nn());

@@ -15,17 +15,24 @@ Vec2 node_xi(FaceKind k, int a) {
 }
 }  // namespace
 
+std::vector<std::vector<int>> node_rings(const Surface& s, std::size_t num_nodes) {
+  std::vector<std::vector<int>> rings(num_nodes);
+  for (const Face& face : s.faces)
+    for (int a = 0; a < face.nn(); ++a) {
+      std::vector<int>& ring = rings[face.nodes[a]];
+      for (int b = 0; b < face.nn(); ++b)
+        if (std::find(ring.begin(), ring.end(), face.nodes[b]) == ring.end()) ring.push_back(face.nodes[b]);
+    }
+  return rings;
+}
+
 void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out) {
   // v_a = sum over faces f at a of t_f(a) = c / |c|, c = x_,xi x x_,eta of f at a (times normal_sign);
   // dc/dX_b = d_area_vector (face.hpp), dt = (I - t t^T) dc / |c|, n_a = v_a / |v_a|.
   if (out.node.size() != num_nodes || out.face.size() != s.faces.size()) {
     out.node.assign(num_nodes, NodeNormal{});
-    for (const Face& face : s.faces)
-      for (int a = 0; a < face.nn(); ++a) {
-        std::vector<int>& ring = out.node[face.nodes[a]].ring;
-        for (int b = 0; b < face.nn(); ++b)
-          if (std::find(ring.begin(), ring.end(), face.nodes[b]) == ring.end()) ring.push_back(face.nodes[b]);
-      }
+    std::vector<std::vector<int>> rings = node_rings(s, num_nodes);
+    for (std::size_t i = 0; i < num_nodes; ++i) out.node[i].ring = std::move(rings[i]);
     out.face.assign(s.faces.size(), FaceX());
     for (std::size_t f = 0; f < s.faces.size(); ++f) out.face[f].resize(3, s.faces[f].nn());
   }

@@ -34,6 +34,11 @@ struct NodalNormals {
   std::vector<NodeNormal> node;
   std::vector<FaceX> face;
 };
+// The ring of every node id used by a face of `s` (ids index an array of num_nodes entries): the nodes
+// of the faces around it, itself included, in the order met; empty for the others. The nodes a nodal
+// normal depends on (NodeNormal::ring), and so the reach of a point's tangent past its face.
+std::vector<std::vector<int>> node_rings(const Surface& s, std::size_t num_nodes);
+
 // `out` keeps its rings and storage between calls on the same surface (one call per Newton iteration):
 // the first call builds them, later calls only recompute the values.
 void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out);
