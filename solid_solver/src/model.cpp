@@ -212,11 +212,11 @@ void SolidModel::partition_() {
 void SolidModel::set_contact(ContactModel* contact) {
   contact_ = contact;
   if (!contact) return;
-  const std::vector<NodeCoupling> extra = contact->couplings(*this);
-  if (!extra.empty()) create_matrix_(extra);
+  extra_ = contact->couplings(*this);
+  if (!extra_.empty()) create_matrix_();
 }
 
-void SolidModel::create_matrix_(const std::vector<NodeCoupling>& extra) {
+void SolidModel::create_matrix_() {
   const int nloc = node_end_ - node_begin_;
   // column nodes (new numbering) of each owned row node
   std::vector<std::vector<PetscInt>> nbr(nloc);
@@ -229,7 +229,7 @@ void SolidModel::create_matrix_(const std::vector<NodeCoupling>& extra) {
     }
   };
   for (const auto& el : mesh_.elements) couple(el.n.data(), el.nn(), el.n.data(), el.nn());
-  for (const auto& c : extra) couple(c.rows.data(), int(c.rows.size()), c.cols.data(), int(c.cols.size()));
+  for (const auto& c : extra_) couple(c.rows.data(), int(c.rows.size()), c.cols.data(), int(c.cols.size()));
   std::vector<PetscInt> dnnz(nloc), onnz(nloc);
   size_t widest = 0;
   for (int i = 0; i < nloc; ++i) {
@@ -269,10 +269,55 @@ void SolidModel::create_matrix_(const std::vector<NodeCoupling>& extra) {
   MatNullSpaceDestroy(&nsp);
   if (ksp_) ANGIO_PETSC(KSPSetOperators(ksp_, K_, K_));
   pc_current_ = false;
+  pattern_ = std::move(nbr);
+}
+
+bool SolidModel::grow_pattern_(const std::vector<NodeCoupling>& needed) {
+  // every rank's new couplings to every rank (a pair evaluated here may add to rows owned elsewhere),
+  // flattened as [#rows, #cols, rows..., cols...] per coupling
+  std::vector<int> mine;
+  for (const auto& c : needed) {
+    mine.push_back(int(c.rows.size()));
+    mine.push_back(int(c.cols.size()));
+    mine.insert(mine.end(), c.rows.begin(), c.rows.end());
+    mine.insert(mine.end(), c.cols.begin(), c.cols.end());
+  }
+  const int n = int(mine.size());
+  std::vector<int> counts(size_), offsets(size_ + 1, 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (int k = 0; k < size_; ++k) offsets[k + 1] = offsets[k] + counts[k];
+  if (offsets[size_] == 0) return false;
+  std::vector<int> all(offsets[size_]);
+  MPI_Allgatherv(mine.data(), n, MPI_INT, all.data(), counts.data(), offsets.data(), MPI_INT, comm_);
+  auto in_pattern = [&](int row, int col) {
+    const int pr = perm_[row];
+    if (pr < node_begin_ || pr >= node_end_) return true;  // another rank's row: its owner checks
+    const auto& v = pattern_[pr - node_begin_];
+    return std::binary_search(v.begin(), v.end(), PetscInt(perm_[col]));
+  };
+  int grew = 0;
+  for (size_t i = 0; i < all.size();) {
+    const int nr = all[i], nc = all[i + 1];
+    const int* rows = all.data() + i + 2;
+    const int* cols = rows + nr;
+    i += 2 + nr + nc;
+    bool missing = false;
+    for (int a = 0; a < nr && !missing; ++a)
+      for (int b = 0; b < nc && !missing; ++b) missing = !in_pattern(rows[a], cols[b]);
+    if (!missing) continue;
+    extra_.push_back({std::vector<int>(rows, rows + nr), std::vector<int>(cols, cols + nc)});
+    grew = 1;
+  }
+  int any = 0;
+  MPI_Allreduce(&grew, &any, 1, MPI_INT, MPI_MAX, comm_);
+  if (!any) return false;
+  create_matrix_();
+  ++pattern_rebuilds_;
+  return true;
 }
 
 void SolidModel::setup_petsc_() {
-  create_matrix_({});
+  create_matrix_();
   ANGIO_PETSC(MatCreateVecs(K_, &du_, &r_));
   ANGIO_PETSC(VecSetBlockSize(du_, 3));
   ANGIO_PETSC(VecScatterCreateToAll(du_, &scatter_, &full_));
@@ -431,6 +476,12 @@ void SolidModel::gather_(Vec v, std::vector<double>& full) {
 }
 
 bool SolidModel::assemble(Vec r, Mat K) {
+  if (contact_) {
+    const double tc = MPI_Wtime();
+    const std::vector<NodeCoupling> needed = contact_->prepare(*this, K != nullptr);
+    if (K && K == K_ && grow_pattern_(needed)) K = K_;
+    contact_seconds_ += MPI_Wtime() - tc;
+  }
   ANGIO_PETSC(VecSet(r, 0.0));
   if (K) ANGIO_PETSC(MatZeroEntries(K));
   int ok = 1;

@@ -486,6 +486,7 @@ void SolidRunner::write_summary_json_() const {
                    {"newton_iterations", t.newton_iterations},
                    {"tangent_assemblies", t.tangent_assemblies},
                    {"factorizations", t.factorizations},
+                   {"matrix_pattern_rebuilds", model_->pattern_rebuilds()},
                    {"linear_iterations", t.linear_iterations},
                    {"assembly_seconds", t.assembly_seconds},
                    {"contact_seconds", t.contact_seconds},

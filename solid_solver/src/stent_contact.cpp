@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <stdexcept>
@@ -247,15 +248,17 @@ PenaltySurfaceContact::PenaltySurfaceContact(const SolidModel& model, Options op
 
 PenaltySurfaceContact::~PenaltySurfaceContact() = default;
 
-void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
+void PenaltySurfaceContact::evaluate_(const SolidModel& model, bool tangent) {
   const double t0 = MPI_Wtime();
   contact::ContactDiagnostics diag;
   double area = 0.0;
+  gather_coords(model, coords_);
+  evaluated_ = {};
+  evaluated_tangent_ = tangent;
   // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything; nothing
   // while the pair is off (the same time on every rank: the reduction below stays collective)
   const bool mine = model.time() >= opt_.from && (opt_.two_pass ? model.rank() == 0 : ss_ != nullptr);
   if (mine) {
-    gather_coords(model, coords_);
     ss_->update(coords_);
     sm_->update(coords_);
     contact::SurfaceContactParams par;
@@ -263,15 +266,42 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
     par.quadrature_degree = opt_.quadrature;
     par.regularization = opt_.regularization;
     par.two_pass = opt_.two_pass;
-    par.compute_tangent = K != nullptr;
-    const auto res = contact::evaluate_surface_contact(*ss_, *sm_, par);
-    insert(model, res.contributions, r, K);
-    diag = res.diag;
-    area = res.active_area;
+    par.compute_tangent = tangent;
+    evaluated_ = contact::evaluate_surface_contact(*ss_, *sm_, par);
+    diag = evaluated_.diag;
+    area = evaluated_.active_area;
   }
   last_ = reduce_summary(diag, area, opt_.search_radius, model.comm(), &active_area_);
   timing_.calls++;
   timing_.seconds += MPI_Wtime() - t0;
+}
+
+std::vector<NodeCoupling> PenaltySurfaceContact::prepare(const SolidModel& model, bool tangent) {
+  evaluate_(model, tangent);
+  std::vector<NodeCoupling> out;
+  if (!tangent) return out;
+  // every slave Gauss point within the search radius of a master face, not only the active ones: a pair
+  // enters the pattern while it approaches, before its first entry
+  for (const auto& gp : evaluated_.points) {
+    const std::uint64_t key = (std::uint64_t(gp.pass) << 62) | (std::uint64_t(gp.slave_face) << 31) |
+                              std::uint64_t(gp.master_face);
+    if (!paired_.insert(key).second) continue;
+    const contact::Face& fs = (gp.pass == 0 ? *slave_ : *master_).faces[gp.slave_face];
+    const contact::Face& fm = (gp.pass == 0 ? *master_ : *slave_).faces[gp.master_face];
+    std::vector<int> nodes(fs.nodes.begin(), fs.nodes.begin() + fs.nn());
+    nodes.insert(nodes.end(), fm.nodes.begin(), fm.nodes.begin() + fm.nn());
+    out.push_back({nodes, nodes});
+  }
+  return out;
+}
+
+void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
+  // what prepare() evaluated, if the configuration is still the same; otherwise (a call without an
+  // assembly, e.g. SolidModel::contact_forces) evaluated now
+  std::vector<contact::Vec3> now;
+  gather_coords(model, now);
+  if (!(now == coords_ && (evaluated_tangent_ || !K))) evaluate_(model, K != nullptr);
+  insert(model, evaluated_.contributions, r, K);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -285,13 +315,25 @@ void CompositeContact::add(const SolidModel& model, Vec r, Mat K) {
   for (auto* m : others_) m->add(model, r, K);
 }
 
-std::vector<NodeCoupling> CompositeContact::couplings(const SolidModel& model) const {
-  std::vector<NodeCoupling> out = stent_ ? stent_->couplings(model) : std::vector<NodeCoupling>{};
-  for (auto* m : others_) {
-    auto c = m->couplings(model);
+namespace {
+// The couplings `of` each model returns, the stent's first, concatenated.
+template <class Of>
+std::vector<NodeCoupling> all_couplings(ContactModel* stent, const std::vector<ContactModel*>& others, Of of) {
+  std::vector<NodeCoupling> out = stent ? of(*stent) : std::vector<NodeCoupling>{};
+  for (auto* m : others) {
+    auto c = of(*m);
     out.insert(out.end(), std::make_move_iterator(c.begin()), std::make_move_iterator(c.end()));
   }
   return out;
+}
+}  // namespace
+
+std::vector<NodeCoupling> CompositeContact::couplings(const SolidModel& model) const {
+  return all_couplings(stent_, others_, [&](ContactModel& m) { return m.couplings(model); });
+}
+
+std::vector<NodeCoupling> CompositeContact::prepare(const SolidModel& model, bool tangent) {
+  return all_couplings(stent_, others_, [&](ContactModel& m) { return m.prepare(model, tangent); });
 }
 
 void CompositeContact::fill_reply(const SolidModel& model, participant::ContactReply& reply) {

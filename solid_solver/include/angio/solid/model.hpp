@@ -43,6 +43,13 @@ class ContactModel {
   // the start. An entry outside the pattern makes PETSc's AIJ matrix reallocate and copy itself on
   // insertion: measured at 85 % of the solid's time in the patient-like scene's first contact steps.
   virtual std::vector<NodeCoupling> couplings(const SolidModel&) const { return {}; }
+  // Called collectively by every assembly before add(), with the same configuration: a model whose pairs
+  // depend on where the surfaces are (balloon-artery Gauss points and the master faces they project
+  // onto) evaluates them here and returns the couplings of the pairs it has not returned before; the
+  // solid grows its matrix's pattern by those of them it lacks, once, before anything is inserted
+  // (one rebuild instead of one reallocation of the matrix per new row), and add() then inserts what
+  // was evaluated here.
+  virtual std::vector<NodeCoupling> prepare(const SolidModel&, bool /*tangent*/) { return {}; }
 };
 
 // The scene's solid.newton keys (core/scene/keys.yaml): meaning and defaults there.
@@ -254,6 +261,7 @@ class SolidModel {
   // centroid of that configuration, for failure messages (same on every rank).
   std::string invalid_element() const;
   Mat matrix() const { return K_; }
+  int pattern_rebuilds() const { return pattern_rebuilds_; }  // of the matrix by contact pairs new to its pattern
   // The options of ModelOptions::petsc_options no solver object has asked for so far (misspelt, or
   // for a split that does not exist).
   std::vector<std::string> unused_petsc_options() const;
@@ -262,9 +270,12 @@ class SolidModel {
  private:
   void partition_();
   void setup_petsc_();
-  // (Re)creates K_ with the pattern of the elements plus `extra`, every entry of it present (explicit
+  // (Re)creates K_ with the pattern of the elements plus extra_, every entry of it present (explicit
   // zeros, kept by MatZeroEntries), its near null space and the KSP's operators.
-  void create_matrix_(const std::vector<NodeCoupling>& extra);
+  void create_matrix_();
+  // Collective: the couplings each rank's contact needs now (ContactModel::prepare) that the pattern lacks are
+  // added to extra_ and K_ is rebuilt with them (true), or nothing changes (false).
+  bool grow_pattern_(const std::vector<NodeCoupling>& needed);
   // Rigid-body modes of the given owned nodes (new numbering; a near null space for GAMG).
   MatNullSpace rigid_body_modes_(const std::vector<PetscInt>& nodes) const;
   // PCFIELDSPLIT: one split per mesh part, named after it.
@@ -341,6 +352,9 @@ class SolidModel {
   int invalid_element_ = -1;      // invalid_element()
   Vec3d invalid_at_ = Vec3d::Zero();
   Mat K_ = nullptr;
+  std::vector<NodeCoupling> extra_;             // the couplings K_'s pattern has beyond the elements'
+  std::vector<std::vector<PetscInt>> pattern_;  // per owned node: its column nodes in K_ (new numbering, sorted)
+  int pattern_rebuilds_ = 0;                    // of K_ by grow_pattern_
   Vec r_ = nullptr, du_ = nullptr;
   KSP ksp_ = nullptr;
   VecScatter scatter_ = nullptr;

@@ -17,12 +17,14 @@
 // (identical data, no communication).
 // Units: mm, N, MPa.
 #pragma once
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "angio/contact/contact.hpp"
@@ -121,6 +123,9 @@ class PenaltySurfaceContact : public ContactModel {
   // Throws std::runtime_error if a surface set is missing.
   PenaltySurfaceContact(const SolidModel& model, Options opt);
   ~PenaltySurfaceContact() override;
+  // Evaluates the pairs of the current configuration (kept for add()) and returns the couplings of the
+  // face pairs within the search radius that no earlier call returned.
+  std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
 
   const ContactSummary& last() const { return last_; }
@@ -131,7 +136,12 @@ class PenaltySurfaceContact : public ContactModel {
   Options opt_;
   std::unique_ptr<contact::Surface> slave_, master_;
   std::unique_ptr<contact::SurfaceSearch> ss_, sm_;
-  std::vector<contact::Vec3> coords_;
+  // Collective: contact at the current configuration into evaluated_ (this rank's pairs) and last_.
+  void evaluate_(const SolidModel& model, bool tangent);
+  std::vector<contact::Vec3> coords_;  // the configuration evaluated_ belongs to
+  contact::SurfaceContactResult evaluated_;
+  bool evaluated_tangent_ = false;
+  std::unordered_set<std::uint64_t> paired_;  // (pass, slave face, master face) returned by prepare()
   ContactSummary last_;
   double active_area_ = 0.0;
   ContactTiming timing_;
@@ -145,6 +155,7 @@ class CompositeContact : public StentContact {
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
   std::vector<NodeCoupling> couplings(const SolidModel& model) const override;  // of all its models
+  std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;  // of all its models
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
