@@ -1,7 +1,7 @@
 // Distributed quasi-static total-Lagrangian solid model (PETSc + MPI).
 //
-// Every rank holds the whole (reference) mesh. Elements are partitioned (contiguous blocks or a
-// PETSc MatPartitioning of the element dual graph); each node is owned by the lowest rank among
+// Every rank holds the whole (reference) mesh. Elements are partitioned (a PETSc MatPartitioning of
+// the element dual graph, or contiguous blocks); each node is owned by the lowest rank among
 // its elements and nodes are renumbered so that every rank owns one contiguous block of DOFs
 // (3 per node, interlaced). Each rank assembles its own elements into an MPIAIJ matrix
 // (block size 3, preallocated) and a residual vector. The total displacement is kept as a full
@@ -118,7 +118,7 @@ struct NewtonOptions {
 };
 
 struct ModelOptions {
-  // "contiguous" or a MatPartitioning type (ptscotch, parmetis, average...)
+  // a MatPartitioning type of the element dual graph (ptscotch, average, square) or "contiguous" index blocks
   std::string partitioner = scene::keys::defaults::solid_partitioner;
   std::string petsc_options;  // appended after the defaults (GMRES(200) + block-Jacobi ILU(1))
   NewtonOptions newton;
