@@ -255,6 +255,7 @@ void PenaltySurfaceContact::evaluate_(const SolidModel& model, bool tangent) {
   gather_coords(model, coords_);
   evaluated_ = {};
   evaluated_tangent_ = tangent;
+  evaluated_time_ = model.time();
   // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything; nothing
   // while the pair is off (the same time on every rank: the reduction below stays collective)
   const bool mine = model.time() >= opt_.from && (opt_.two_pass ? model.rank() == 0 : ss_ != nullptr);
@@ -300,7 +301,7 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
   // assembly, e.g. SolidModel::contact_forces) evaluated now
   std::vector<contact::Vec3> now;
   gather_coords(model, now);
-  if (!(now == coords_ && (evaluated_tangent_ || !K))) evaluate_(model, K != nullptr);
+  if (!(now == coords_ && model.time() == evaluated_time_ && (evaluated_tangent_ || !K))) evaluate_(model, K != nullptr);
   insert(model, evaluated_.contributions, r, K);
 }
 
