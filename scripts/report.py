@@ -589,10 +589,22 @@ def _straightening_rows(straight):
     ]
 
 
+def geometry_dir(run, scene):
+    """The patient pipeline's geometry directory of a run (with placement.json): the run's own, or, for
+    a run continued from another (launch.py --resume), the one its artery mesh was written to; None
+    for a scene without the pipeline."""
+    mesh = get(scene, "artery", "mesh", "file")
+    for d in [run / "geometry"] + ([(run / str(mesh)).parent] if isinstance(mesh, str) else []):
+        if (d / "placement.json").is_file():
+            return d
+    return None
+
+
 def artery_report(run, scene, solid, beam, with_paper):
     """Table rows (stent rows, artery rows), the results.json "artery" section and the plot data of an
     artery scene."""
-    P = (PAPER_PATIENT if (run / "geometry" / "placement.json").is_file() else PAPER_ARTERY) if with_paper else {}
+    geometry = geometry_dir(run, scene)
+    P = (PAPER_PATIENT if geometry else PAPER_ARTERY) if with_paper else {}
     steps = [s for s in (get(solid, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
     beam_steps = [s for s in (get(beam, "steps") or []) if isinstance(s, dict) and num(s.get("time")) is not None]
     layers = artery_layers(solid, scene)
@@ -623,22 +635,22 @@ def artery_report(run, scene, solid, beam, with_paper):
     section["contact_force_at_peak"], force_rows = _contact_force_summary(phase_out)
     rows += force_rows
     plots = _artery_plots(steps, layers, section["lumen"], ext, times)
-    straight = artery_straightening(run, times)
+    straight = artery_straightening(run, geometry, times)
     if straight:
         section["straightening"] = straight
         rows += _straightening_rows(straight)
     return (stent_rows, rows), section, plots
 
 
-def artery_straightening(run, times):
+def artery_straightening(run, geometry, times):
     """Bow of a patient artery's lumen axis over the stented section (scripts/patient/straightening.py)."""
-    if not (run / "geometry" / "placement.json").is_file():
+    if geometry is None:
         return None
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     try:
         from patient.straightening import artery_axis_bow
 
-        return artery_axis_bow(run, times)
+        return artery_axis_bow(run, times, geometry)
     except ImportError:  # h5py or numpy missing: the table goes without it
         return None
 

@@ -32,13 +32,14 @@ def bow(end0, middle, end1):
     return {"sagitta": sagitta, "radius": radius, "chord": chord}
 
 
-def artery_axis_bow(run_dir, times):
+def artery_axis_bow(run_dir, times, geometry=None):
     """{label: {time, sagitta, radius, chord}} for the reference and the h5 steps nearest to each of
-    `times` ({label: t}); None when the run is not a patient run or lacks the files."""
+    `times` ({label: t}); None when the run is not a patient run or lacks the files. `geometry`: the
+    pipeline's directory (default run_dir/geometry; a continued run's is its first run's)."""
     import h5py
 
     run = Path(run_dir)
-    geo = run / "geometry"
+    geo = Path(geometry) if geometry else run / "geometry"
     try:
         plc = json.loads((geo / "placement.json").read_text())
         lumen = read_centerline_csv(geo / "lumen.csv")

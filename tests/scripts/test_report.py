@@ -15,6 +15,8 @@ import tempfile
 import unittest
 from pathlib import Path
 
+import yaml
+
 ROOT = Path(__file__).resolve().parents[2]
 REPORT = ROOT / "scripts" / "report.py"
 ATM = 0.101325
@@ -464,6 +466,27 @@ class EmptyRun(unittest.TestCase):
             rows = table(r.stdout)
             self.assertIn("prestressed: media max principal stress (kPa)", rows)
             self.assertFalse(any("nodal" in n for n in rows))  # a run before the nodal recovery: no nodal rows
+
+
+class ContinuedPatientRun(unittest.TestCase):
+    def test_paper_column_follows_the_geometry_of_the_first_run(self):
+        """A patient run continued with launch.py --resume: its directory has no geometry/ of its own;
+        the artery mesh in its scene points into the first run's, whose placement.json makes it a
+        patient run (the paper's §4.2 patient in the column, not the generic artery of §4.1)."""
+        with tempfile.TemporaryDirectory() as tmp:
+            first = Path(tmp) / "first"
+            write(first / "geometry" / "placement.json", "{}")
+            run = first / "continued"
+            make_artery_run(run)
+            scene = yaml.safe_load((run / "scene.yaml").read_text())
+            scene["artery"]["mesh"] = {"file": str(first / "geometry" / "artery.msh")}
+            (run / "scene.yaml").write_text(yaml.safe_dump(scene))
+            r = run_report(run)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            rows = table(r.stdout)
+            # the media at peak: 78.3 kPa in the paper's patient, where its generic artery's column gives
+            # the innermost layer's 7,990 kPa (this run's media is its innermost layer)
+            self.assertEqual(rows["peak: media max principal stress (kPa)"][1], "78.3")
 
 
 if __name__ == "__main__":
