@@ -284,8 +284,8 @@ std::vector<NodeCoupling> PenaltySurfaceContact::prepare(const SolidModel& model
   // every slave Gauss point within the search radius of a master face, not only the active ones: a pair
   // enters the pattern while it approaches, before its first entry
   for (const auto& gp : evaluated_.points) {
-    const std::uint64_t key = (std::uint64_t(gp.pass) << 62) | (std::uint64_t(gp.slave_face) << 31) |
-                              std::uint64_t(gp.master_face);
+    const std::uint64_t key =
+        (std::uint64_t(gp.pass) << 62) | (std::uint64_t(gp.slave_face) << 31) | std::uint64_t(gp.master_face);
     if (!paired_.insert(key).second) continue;
     const contact::Face& fs = (gp.pass == 0 ? *slave_ : *master_).faces[gp.slave_face];
     const contact::Face& fm = (gp.pass == 0 ? *master_ : *slave_).faces[gp.master_face];
@@ -301,7 +301,8 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
   // assembly, e.g. SolidModel::contact_forces) evaluated now
   std::vector<contact::Vec3> now;
   gather_coords(model, now);
-  if (!(now == coords_ && model.time() == evaluated_time_ && (evaluated_tangent_ || !K))) evaluate_(model, K != nullptr);
+  if (!(now == coords_ && model.time() == evaluated_time_ && (evaluated_tangent_ || !K)))
+    evaluate_(model, K != nullptr);
   insert(model, evaluated_.contributions, r, K);
 }
 

@@ -36,7 +36,9 @@ STRESS_TOL = 1e-9  # relative, per step and layer
 def run(bin_dir, ranks, run_dir):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OPENBLAS_NUM_THREADS="1")
     cmd = ["mpirun", "--oversubscribe", "-n", str(ranks), str(Path(bin_dir) / "solid_solver")]
-    r = subprocess.run(cmd + ["--scene", str(SCENE), "--run-dir", str(run_dir)], env=env, capture_output=True, text=True)
+    r = subprocess.run(
+        cmd + ["--scene", str(SCENE), "--run-dir", str(run_dir)], env=env, capture_output=True, text=True
+    )
     check(r.returncode == 0, f"{ranks} rank(s): solid_solver exits 0 (got {r.returncode})")
     if r.returncode != 0:
         print(r.stdout[-3000:], r.stderr[-3000:])
@@ -53,20 +55,30 @@ def compare(ranks, ref, other):
     for part in u1:
         scale = np.abs(u1[part]).max()
         diff = np.abs(u1[part] - un[part]).max()
-        check(diff <= DISPLACEMENT_TOL * scale, f"{ranks} ranks: {part} displacement within {DISPLACEMENT_TOL:g} of "
-              f"its maximum {scale:.4g} mm of 1 rank's (max difference {diff:.3g} mm)")
+        check(
+            diff <= DISPLACEMENT_TOL * scale,
+            f"{ranks} ranks: {part} displacement within {DISPLACEMENT_TOL:g} of "
+            f"its maximum {scale:.4g} mm of 1 rank's (max difference {diff:.3g} mm)",
+        )
     check(len(steps1) == len(stepsn), f"{ranks} ranks: the same {len(steps1)} steps")
     worst = 0.0
-    for key in ("max_principal_stress", "p99_principal_stress", "max_principal_stress_nodal",
-                "p99_principal_stress_nodal"):
+    for key in (
+        "max_principal_stress",
+        "p99_principal_stress",
+        "max_principal_stress_nodal",
+        "p99_principal_stress_nodal",
+    ):
         # relative to the value, or to 1e-6 of the run's largest value of the measure where the value
         # is round-off of zero (the unloaded artery of the first step: 1e-17 MPa)
         floor = 1e-6 * max(abs(v) for s in steps1 for v in s[key].values())
         for a, b in zip(steps1, stepsn):
             for layer, v in a[key].items():
                 worst = max(worst, abs(v - b[key][layer]) / max(abs(v), floor))
-    check(worst <= STRESS_TOL, f"{ranks} ranks: per-layer stresses of every step within {STRESS_TOL:g} "
-          f"relative of 1 rank's (worst {worst:.3g})")
+    check(
+        worst <= STRESS_TOL,
+        f"{ranks} ranks: per-layer stresses of every step within {STRESS_TOL:g} "
+        f"relative of 1 rank's (worst {worst:.3g})",
+    )
 
 
 def main():

@@ -155,7 +155,7 @@ class CompositeContact : public StentContact {
   void add_model(ContactModel* m) { others_.push_back(m); }
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
-  std::vector<NodeCoupling> couplings(const SolidModel& model) const override;  // of all its models
+  std::vector<NodeCoupling> couplings(const SolidModel& model) const override;        // of all its models
   std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;  // of all its models
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
