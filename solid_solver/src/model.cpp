@@ -981,6 +981,7 @@ std::vector<Vec3d> SolidModel::contact_forces(ContactModel& c) {
   Vec f;
   ANGIO_PETSC(VecDuplicate(r_, &f));
   ANGIO_PETSC(VecSet(f, 0.0));
+  c.prepare(*this, false);  // the contact of this configuration, as an assembly evaluates it
   c.add(*this, f, nullptr);
   ANGIO_PETSC(VecAssemblyBegin(f));
   ANGIO_PETSC(VecAssemblyEnd(f));

@@ -252,14 +252,13 @@ void PenaltySurfaceContact::evaluate_(const SolidModel& model, bool tangent) {
   const double t0 = MPI_Wtime();
   contact::ContactDiagnostics diag;
   double area = 0.0;
-  gather_coords(model, coords_);
   evaluated_ = {};
   evaluated_tangent_ = tangent;
-  evaluated_time_ = model.time();
   // one pass: every rank its slice of slave faces; two_pass: rank 0 evaluates everything; nothing
   // while the pair is off (the same time on every rank: the reduction below stays collective)
   const bool mine = model.time() >= opt_.from && (opt_.two_pass ? model.rank() == 0 : ss_ != nullptr);
   if (mine) {
+    gather_coords(model, coords_);
     ss_->update(coords_);
     sm_->update(coords_);
     contact::SurfaceContactParams par;
@@ -279,6 +278,7 @@ void PenaltySurfaceContact::evaluate_(const SolidModel& model, bool tangent) {
 
 std::vector<NodeCoupling> PenaltySurfaceContact::prepare(const SolidModel& model, bool tangent) {
   evaluate_(model, tangent);
+  prepared_ = true;
   std::vector<NodeCoupling> out;
   if (!tangent) return out;
   // every slave Gauss point within the search radius of a master face, not only the active ones: a pair
@@ -297,12 +297,10 @@ std::vector<NodeCoupling> PenaltySurfaceContact::prepare(const SolidModel& model
 }
 
 void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
-  // what prepare() evaluated, if the configuration is still the same; otherwise (a call without an
-  // assembly, e.g. SolidModel::contact_forces) evaluated now
-  std::vector<contact::Vec3> now;
-  gather_coords(model, now);
-  if (!(now == coords_ && model.time() == evaluated_time_ && (evaluated_tangent_ || !K)))
-    evaluate_(model, K != nullptr);
+  // what prepare() evaluated: the model calls it right before (ContactModel::prepare); a call on its own
+  // (or one that needs the tangent prepare() did not compute) evaluates now
+  if (!prepared_ || (K && !evaluated_tangent_)) evaluate_(model, K != nullptr);
+  prepared_ = false;
   insert(model, evaluated_.contributions, r, K);
 }
 

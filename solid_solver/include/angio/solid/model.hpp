@@ -48,7 +48,7 @@ class ContactModel {
   // onto) evaluates them here and returns the couplings of the pairs it has not returned before; the
   // solid grows its matrix's pattern by those of them it lacks, once, before anything is inserted
   // (one rebuild instead of one reallocation of the matrix per new row), and add() then inserts what
-  // was evaluated here.
+  // was evaluated here. The model calls add() only right after prepare() at the same configuration.
   virtual std::vector<NodeCoupling> prepare(const SolidModel&, bool /*tangent*/) { return {}; }
 };
 

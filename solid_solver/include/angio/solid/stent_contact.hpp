@@ -138,10 +138,10 @@ class PenaltySurfaceContact : public ContactModel {
   std::unique_ptr<contact::SurfaceSearch> ss_, sm_;
   // Collective: contact at the current configuration into evaluated_ (this rank's pairs) and last_.
   void evaluate_(const SolidModel& model, bool tangent);
-  std::vector<contact::Vec3> coords_;  // the configuration evaluated_ belongs to, and its time (the pair's `from`)
-  double evaluated_time_ = 0.0;
+  std::vector<contact::Vec3> coords_;
   contact::SurfaceContactResult evaluated_;
   bool evaluated_tangent_ = false;
+  bool prepared_ = false;                     // evaluated_ is prepare()'s, for the add() that follows it
   std::unordered_set<std::uint64_t> paired_;  // (pass, slave face, master face) returned by prepare()
   ContactSummary last_;
   double active_area_ = 0.0;
