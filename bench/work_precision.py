@@ -161,6 +161,8 @@ def outputs_of(run_dir):
             for layer, v in (ph.get(phase, {}).get("layers") or {}).items():
                 out[f"{layer}_max_{phase}"] = v.get("max_principal_stress")
                 out[f"{layer}_p99_{phase}"] = v.get("p99_principal_stress")
+                # averaged over a ball of fixed radius: the measure that converges at a strut
+                out[f"{layer}_avg_{phase}"] = v.get("max_principal_stress_averaged")
                 # recovered at the nodes (report.py): where the element value sits half an element inside
                 out[f"{layer}_max_nodal_{phase}"] = v.get("max_principal_stress_nodal")
     else:

@@ -425,6 +425,7 @@ void read_artery(const Node& a, const scene::LoadCurves& curves, SolidScene& sc)
     s->check_keys();
     sc.apposition_threshold = s->get<double>("apposition_threshold");
     sc.lumen_max_stations = s->get<int>("lumen_stations");
+    sc.stress_average_radius = s->get<double>("stress_average_radius");
   }
   sc.mesh.append(m);
 }

@@ -65,6 +65,7 @@ def compare(ranks, ref, other):
     for key in (
         "max_principal_stress",
         "p99_principal_stress",
+        "max_principal_stress_averaged",
         "max_principal_stress_nodal",
         "p99_principal_stress_nodal",
     ):

@@ -9,8 +9,9 @@
 namespace angio::solid {
 
 // The q-quantile (0 < q ≤ 1) of `values` weighted by `weights` (e.g. element volumes): the smallest
-// value v such that the values ≤ v carry at least q of the total weight. Unlike the maximum, which sits
-// at one element next to a strut and changes with the mesh, it converges under refinement.
+// value v such that the values ≤ v carry at least q of the total weight. Robust against the one element
+// of the maximum; where struts press the wall, q's share of the volume may still lie within the singular
+// field of the line load (stress_average.hpp), and the quantile then grows under refinement too.
 // Empty input: NaN.
 double weighted_quantile(std::vector<double> values, std::vector<double> weights, double q);
 

@@ -46,6 +46,10 @@ void reset_reply(const participant::SamplePoints& points, participant::ContactRe
 struct BlockStress {
   Vec3d where = Vec3d::Zero();  // current centroid of the element with the maximum
   double p99 = 0.0;             // 99th percentile by reference volume (MPa), robust against one element at a strut
+  // max over the block of the element stress averaged over a ball of radius stress_average_radius
+  // (stress_average.hpp: the measure that converges under refinement at a strut), rank 0 only; NaN: none
+  double max_averaged = std::numeric_limits<double>::quiet_NaN();
+  Vec3d where_averaged = Vec3d::Zero();  // current centroid of the element whose ball holds it
   // The recovered nodal first principal stress of the block (stress_recovery.hpp: L2 projection onto
   // the block's own nodes, a layer interface node has one value per layer), rank 0 only; NaN: none.
   double max_nodal = std::numeric_limits<double>::quiet_NaN();  // max over the block's nodes (MPa)

@@ -62,7 +62,8 @@ struct SolidScene {
   // apposition threshold (a strut farther than this from the endothelium is malapposed).
   std::optional<DiameterSpec> lumen;  // node_set: "artery_inner"
   int lumen_max_stations = scene::keys::defaults::artery_summary_lumen_stations;
-  double apposition_threshold = scene::keys::defaults::artery_summary_apposition_threshold;  // mm
+  double apposition_threshold = scene::keys::defaults::artery_summary_apposition_threshold;    // mm
+  double stress_average_radius = scene::keys::defaults::artery_summary_stress_average_radius;  // mm
   bool has_balloon = false, has_artery = false;
   int ranks = 0;  // solid.ranks (0: not given)
   // Norm of the nodal force vector of all pressures at their curves' peaks, reference mesh (N): the

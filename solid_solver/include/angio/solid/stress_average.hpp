@@ -1,0 +1,27 @@
+// A stress read at a physical length instead of at one element (pure function, no MPI). Units: mm, MPa.
+//
+// A strut modelled as a beam presses the wall along a line, and the stress of a line load on an
+// elastic body grows as 1/r towards the line (Flamant; Johnson, Contact Mechanics, 1985, §2.2): the
+// element maximum, and a 99th percentile whose 1 % of the volume lies within the strut's own radius,
+// are set by the element size there and grow under refinement instead of converging. The
+// mixed-dimensional model itself holds only for solid elements not smaller than the beam's cross
+// section (Datz et al., §2.4, after Steinbrecher et al.), so refining towards the line is not an
+// option either. Averaged over a ball of fixed radius ρ, the 1/r field is integrable and the average
+// converges as h/ρ → 0 (the "volume method" of the theory of critical distances, Taylor, The Theory
+// of Critical Distances, 2007, §2.5).
+#pragma once
+#include <vector>
+
+#include "angio/solid/mesh.hpp"
+
+namespace angio::solid {
+
+// For every element i: the volume-weighted mean of `value` over the elements j whose centroids lie
+// within `radius` of element i's centroid (i included), Σ v_j f_j / Σ v_j. The elements passed form
+// one group (one layer: stresses jump across layer interfaces and are averaged within a layer only).
+// Neighbours are found through a uniform grid of cells of size `radius` (27 cells per element), so
+// the cost is O(n · elements per ball). radius ≤ 0 or non-finite: invalid_argument.
+std::vector<double> ball_average(const std::vector<Vec3d>& centroid, const std::vector<double>& value,
+                                 const std::vector<double>& volume, double radius);
+
+}  // namespace angio::solid
