@@ -184,6 +184,27 @@ double TubeStenosis::lumen_radius(double Ri, double z) const {
   return Ri * (1.0 - severity * 0.5 * (1.0 + std::cos(2.0 * std::numbers::pi * d / length)));
 }
 
+std::vector<double> TubeAxialRefinement::stations(double length, int n_axial) const {
+  auto uniform = [](std::vector<double>& z, double a, double b, int n) {
+    for (int k = 1; k <= n; ++k) z.push_back(a + (b - a) * k / n);
+  };
+  std::vector<double> z{0.0};
+  if (factor == 1.0) {
+    uniform(z, 0.0, length, n_axial);
+    return z;
+  }
+  const double a = from + 0.5 * length, b = to + 0.5 * length, h = length / n_axial;
+  if (!(factor >= 1.0) || !(a >= 0.0) || !(a < b) || !(b <= length * (1.0 + 1e-12)))
+    throw std::runtime_error("tube: an axial refinement needs factor >= 1 and -length/2 <= from < to <= length/2");
+  auto count = [](double n) { return n > 1e-9 ? std::max(1, int(std::lround(n))) : 0; };
+  const int n0 = count(a / h), nw = std::max(1, int(std::lround((b - a) / h * factor))), n1 = count((length - b) / h);
+  if (n0) uniform(z, 0.0, a, n0);
+  uniform(z, a, b, nw);
+  if (n1) uniform(z, b, length, n1);
+  z.back() = length;
+  return z;
+}
+
 Mesh make_tube(const TubeSpec& s) {
   if (s.layers.empty()) throw std::runtime_error("tube: no layers");
   if (s.n_circ < 3 || s.n_axial < 1) throw std::runtime_error("tube: n_circ >= 3 and n_axial >= 1 required");
@@ -192,9 +213,16 @@ Mesh make_tube(const TubeSpec& s) {
   std::vector<int> layer_of_shell;
   for (size_t l = 0; l < s.layers.size(); ++l) {
     const auto& L = s.layers[l];
-    if (L.n_radial < 1 || !(L.thickness > 0)) throw std::runtime_error("tube: bad layer " + L.name);
+    if (L.n_radial < 1 || !(L.thickness > 0) || !(L.progression > 0))
+      throw std::runtime_error("tube: bad layer " + L.name);
+    // element j of the layer is progression^j times the first one
+    double sum = 0.0;
+    for (int j = 0; j < L.n_radial; ++j) sum += std::pow(L.progression, j);
+    const double r0 = radii.back();
+    double acc = 0.0;
     for (int j = 0; j < L.n_radial; ++j) {
-      radii.push_back(radii.back() + L.thickness / L.n_radial);
+      acc += std::pow(L.progression, j) / sum;
+      radii.push_back(j + 1 == L.n_radial ? r0 + L.thickness : r0 + L.thickness * acc);
       layer_of_shell.push_back(int(l));
     }
     m.blocks.push_back({L.name, s.part});
@@ -205,15 +233,18 @@ Mesh make_tube(const TubeSpec& s) {
                              std::to_string(s.centerline->length()) + " mm)");
   if (s.stenosis.severity > 0.0 && !(s.stenosis.severity < 1.0 && s.stenosis.length > 0.0))
     throw std::runtime_error("tube: a stenosis needs 0 < severity < 1 and a positive length");
-  const int nc = s.n_circ, nr = int(radii.size()), na = s.n_axial + 1;
+  const std::vector<double> zs = s.axial_refinement.stations(s.length, s.n_axial);
+  const int nc = s.n_circ, nr = int(radii.size()), na = int(zs.size());
   auto node = [&](int i, int j, int k) { return (k * nr + j) * nc + (i % nc); };
   const double z0 = s.center.z() - 0.5 * s.length;
   const int n1 = s.layers.front().n_radial;  // shells 0..n1 bound the innermost layer
   std::vector<double> r(nr);
   for (int k = 0; k < na; ++k) {
-    const double zk = s.length * k / s.n_axial;  // from end0
+    const double zk = zs[k];  // from end0
     const double rl = s.stenosis.lumen_radius(s.inner_radius, zk - 0.5 * s.length);
-    for (int j = 0; j < nr; ++j) r[j] = j <= n1 ? rl + (radii[n1] - rl) * j / n1 : radii[j];
+    // the innermost layer's shells keep their graded fractions between the lumen and its outer radius
+    for (int j = 0; j < nr; ++j)
+      r[j] = j <= n1 ? rl + (radii[n1] - rl) * (radii[j] - radii[0]) / (radii[n1] - radii[0]) : radii[j];
     for (int j = 0; j < nr; ++j)
       for (int i = 0; i < nc; ++i) {
         const double th = 2.0 * std::numbers::pi * i / nc;

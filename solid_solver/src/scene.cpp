@@ -156,11 +156,11 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     }
     return m;
   }
-  mesh.check_keys(layered
-                      ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ", "n_axial",
-                                                           "center", "layers", "centerline", "start", "stenosis"}
-                      : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall", "n_circ",
-                                                           "n_axial", "center", "centerline", "start"});
+  mesh.check_keys(layered ? std::initializer_list<const char*>{"generator", "length", "outer_diameter", "n_circ",
+                                                               "n_axial", "center", "layers", "centerline", "start",
+                                                               "stenosis", "axial_refinement"}
+                          : std::initializer_list<const char*>{"generator", "length", "outer_diameter", "wall",
+                                                               "n_circ", "n_axial", "center", "centerline", "start"});
   if (mesh.get<std::string>("generator") != "tube") mesh.child("generator").fail("tube");
   TubeSpec t;
   t.part = part;
@@ -182,6 +182,7 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
       tl.name = l.get<std::string>("name");
       tl.thickness = l.get<double>("thickness");
       tl.n_radial = l.get<int>("n_radial");
+      tl.progression = l.get<double>("progression");
       wall += tl.thickness;
       t.layers.push_back(tl);
     }
@@ -200,6 +201,16 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     if (std::abs(t.stenosis.position) + 0.5 * t.stenosis.length > 0.5 * t.length)
       st->child("length").fail(
           "a stenosis within the tube (|position| + length/2 <= " + std::to_string(0.5 * t.length) + " mm)");
+  }
+  if (auto ar = mesh.optional("axial_refinement")) {  // finer elements over the stented segment (mesh.hpp)
+    ar->check_keys();
+    auto& r = t.axial_refinement;
+    r.from = ar->get<double>("from");
+    r.to = ar->get<double>("to");
+    r.factor = ar->get<double>("factor");
+    if (!(r.from < r.to) || r.from < -0.5 * t.length || r.to > 0.5 * t.length)
+      ar->child("to").fail("a window within the tube with from < to (both within +-" + std::to_string(0.5 * t.length) +
+                           " mm of its centre)");
   }
   if (auto cl = mesh.optional("centerline")) {
     // curved tube: the straight tube warped onto the centerline like the stent (paper §2.4)
@@ -226,7 +237,8 @@ Mesh read_part_mesh(const Node& mesh, const std::string& part, bool layered, Axi
     mesh.child("start").fail("no 'start' without a 'centerline'");
   }
   axis = Axis{t.center, Vec3d::UnitZ()};
-  check_memory(mesh, double(t.n_circ) * (t.n_axial + 1.0) * (shells(t) + 1.0));
+  check_memory(mesh,
+               double(t.n_circ) * double(t.axial_refinement.stations(t.length, t.n_axial).size()) * (shells(t) + 1.0));
   Mesh m;
   try {
     m = make_tube(t);

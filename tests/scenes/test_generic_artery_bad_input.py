@@ -2,7 +2,8 @@
 """Bad input in the generic artery scene's keys is refused through the launcher: exit code 2 and a
 message naming the file and the key path (docs/user-guide.md "Scenes"). One case per new key of the artery
 procedure: viscous tau <= 0, beta < 0, apposition threshold < 0, a layer without a material,
-an unknown key in the viscous branch, too many lumen stations; a solid Newton atol of the order of
+an unknown key in the viscous branch, too many lumen stations, a stress-average radius of 0, an
+axial refinement window outside the tube, a radial progression of 0; a solid Newton atol of the order of
 the peak pressure load and a coupling rel_tol of 1 (tolerances that pass a step before it moves);
 pressures far outside any clinical range (units mistaken); PETSc options naming a preconditioner or
 factorization package that does not exist.
@@ -40,6 +41,21 @@ CASES = [
         "artery.summary.lumen_stations",
     ),
     ("layer without material", lambda s: s["artery"]["layers"].pop("adventitia"), "artery.layers"),
+    (
+        "stress average radius 0",
+        lambda s: s["artery"].update(summary={"stress_average_radius": 0.0}),
+        "artery.summary.stress_average_radius",
+    ),
+    (
+        "axial refinement outside the tube",
+        lambda s: s["artery"]["mesh"].update(axial_refinement={"from": -3.0, "to": 8.0, "factor": 2.0}),
+        "artery.mesh.axial_refinement.to",
+    ),
+    (
+        "radial progression 0",
+        lambda s: s["artery"]["mesh"]["layers"][0].update(progression=0.0),
+        "artery.mesh.layers[0].progression",
+    ),
     # tolerances that accept a step before it moves (the Newton ladder's atol 1 N ended "ok" uninflated)
     ("solid atol of the order of the load", lambda s: s["solid"]["newton"].update(atol=1.0), "solid.newton.atol"),
     ("coupling rel_tol 1", lambda s: s["coupling"].update(rel_tol=1.0), "coupling.rel_tol"),

@@ -66,10 +66,24 @@ struct Mesh {
 // centerline.map(θ, start + z, r), z in [0, length] (the axis is not stretched, the cross-section
 // frame has minimal twist: the same warp as the stent's); `center` is not used. Fiber frames
 // then follow the curved axis (set_frames_from_curved_axis).
+// Resolution where the stresses are read: `progression` grades a layer's elements radially (each
+// this many times thicker than the one inside it, gmsh's "Progression"; > 1: finest at the lumen,
+// where the struts press), TubeAxialRefinement shortens the elements over an axial window (the
+// stented segment). Both keep the mesh structured and conforming.
 struct TubeLayer {
   std::string name;
   double thickness = 0.0;
   int n_radial = 1;
+  double progression = 1.0;
+};
+// Elements `factor` times shorter than length/n_axial over the window [from, to] (mm along the axis
+// from the tube's centre); the parts outside keep about length/n_axial (counts rounded, at least one
+// element per non-empty part). factor 1: uniform.
+struct TubeAxialRefinement {
+  double from = 0.0, to = 0.0;  // mm, from the tube's centre
+  double factor = 1.0;
+  // Axial node stations from end0 (mm), n + 1 of them for n elements, from 0 to length.
+  std::vector<double> stations(double length, int n_axial) const;
 };
 // Idealized concentric stenosis of a tube (the straight stenosed vessel of the stenting literature,
 // e.g. Lally et al., J Biomech 38 (2005) 1574; Zahedmanesh & Lally, Med Biol Eng Comput 47 (2009)
@@ -97,6 +111,7 @@ struct TubeSpec {
   std::optional<geometry::Centerline> centerline;  // curved axis (none: straight along +z)
   double start = 0.0;                              // mm, arc length of end0 on the centerline
   TubeStenosis stenosis;
+  TubeAxialRefinement axial_refinement;
 };
 // Throws std::runtime_error on bad parameters or a tube that does not fit on the centerline.
 Mesh make_tube(const TubeSpec& spec);
