@@ -264,43 +264,67 @@ void SolidRunner::end_step(bool accept) {
 }
 
 void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const {
-  // every local element as (block, p1, volume, current centroid) gathered on rank 0
+  // every local element as (element, p1, reference volume) gathered on rank 0, which holds the whole
+  // mesh and the current positions of all nodes
   const auto& mesh = model_->mesh();
   const auto& le = model_->local_elements();
   std::vector<double> mine;
-  mine.reserve(6 * le.size());
-  for (size_t i = 0; i < le.size(); ++i) {
-    const auto& el = mesh.elements[le[i]];
-    Vec3d c = Vec3d::Zero();
-    for (int a = 0; a < el.nn(); ++a) c += model_->position(el.n[a]);
-    c /= double(el.nn());
-    mine.insert(mine.end(), {double(el.block), p1[i], vol[i], c(0), c(1), c(2)});
-  }
+  mine.reserve(3 * le.size());
+  for (size_t i = 0; i < le.size(); ++i) mine.insert(mine.end(), {double(le[i]), p1[i], vol[i]});
   const std::vector<double> all = gather_on_root(comm_, mine);
   const size_t nb = mesh.blocks.size();
   s.stress.assign(nb, BlockStress{});
   if (rank_ != 0) return;
-  std::vector<std::vector<double>> values(nb), weights(nb);
-  std::vector<std::vector<Vec3d>> centroids(nb);
+  // per block: element values and volumes (max, p99); for the ball average (stress_average.hpp) the
+  // elements' Gauss points in the current configuration, each with the element's value and its share
+  // w_q / Σw of the element's reference volume, and the centres: element centroids, then the nodes
+  std::vector<std::vector<double>> values(nb), weights(nb), point_value(nb), point_weight(nb);
+  std::vector<std::vector<Vec3d>> centres(nb), points(nb);
+  std::vector<char> has_node(nb * mesh.X.size(), 0);
   std::vector<double> best(nb, -std::numeric_limits<double>::infinity());
-  for (size_t k = 0; k + 5 < all.size(); k += 6) {
-    const int b = int(all[k]);
-    values[b].push_back(all[k + 1]);
-    weights[b].push_back(all[k + 2]);
-    centroids[b].emplace_back(all[k + 3], all[k + 4], all[k + 5]);
-    if (all[k + 1] > best[b]) {
-      best[b] = all[k + 1];
-      s.stress[b].where = centroids[b].back();
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  for (size_t k = 0; k + 2 < all.size(); k += 3) {
+    const auto& el = mesh.elements[size_t(all[k])];
+    const int b = el.block;
+    const double v = all[k + 1], volume = all[k + 2];
+    values[b].push_back(v);
+    weights[b].push_back(volume);
+    Vec3d c = Vec3d::Zero();
+    for (int a = 0; a < el.nn(); ++a) {
+      c += model_->position(el.n[a]);
+      has_node[size_t(b) * mesh.X.size() + size_t(el.n[a])] = 1;
+    }
+    centres[b].push_back(c / double(el.nn()));
+    if (v > best[b]) {
+      best[b] = v;
+      s.stress[b].where = centres[b].back();
+    }
+    const auto& rule = volume_rule(el.type);
+    double wsum = 0.0;
+    for (const auto& q : rule) wsum += q.w;
+    for (const auto& q : rule) {
+      shape(el.type, q.xi, N, dN);
+      Vec3d x = Vec3d::Zero();
+      for (int a = 0; a < el.nn(); ++a) x += N(a) * model_->position(el.n[a]);
+      points[b].push_back(x);
+      point_value[b].push_back(v);
+      point_weight[b].push_back(volume * q.w / wsum);
     }
   }
   for (size_t b = 0; b < nb; ++b) {
     BlockStress& bs = s.stress[b];
     bs.p99 = weighted_quantile(values[b], weights[b], 0.99);
     if (values[b].empty()) continue;
-    const std::vector<double> avg = ball_average(centroids[b], values[b], weights[b], scene_.stress_average_radius);
-    const size_t i = size_t(std::max_element(avg.begin(), avg.end()) - avg.begin());
-    bs.max_averaged = avg[i];
-    bs.where_averaged = centroids[b][i];
+    for (size_t n = 0; n < mesh.X.size(); ++n)
+      if (has_node[b * mesh.X.size() + n]) centres[b].push_back(model_->position(int(n)));
+    const std::vector<double> avg =
+        ball_average(centres[b], points[b], point_value[b], point_weight[b], scene_.stress_average_radius);
+    for (size_t i = 0; i < avg.size(); ++i)
+      if (std::isfinite(avg[i]) && !(avg[i] <= bs.max_averaged)) {  // max_averaged starts NaN; an empty ball is NaN
+        bs.max_averaged = avg[i];
+        bs.where_averaged = centres[b][i];
+      }
   }
 }
 

@@ -16,12 +16,16 @@
 
 namespace angio::solid {
 
-// For every element i: the volume-weighted mean of `value` over the elements j whose centroids lie
-// within `radius` of element i's centroid (i included), Σ v_j f_j / Σ v_j. The elements passed form
-// one group (one layer: stresses jump across layer interfaces and are averaged within a layer only).
-// Neighbours are found through a uniform grid of cells of size `radius` (27 cells per element), so
-// the cost is O(n · elements per ball). radius ≤ 0 or non-finite: invalid_argument.
-std::vector<double> ball_average(const std::vector<Vec3d>& centroid, const std::vector<double>& value,
-                                 const std::vector<double>& volume, double radius);
+// For every centre c: the weighted mean of `value` over the sample points within `radius` of c,
+// Σ w_j f_j / Σ w_j over |x_j − c| ≤ radius (NaN where no point lies in the ball). The sample points
+// discretize the integral over the ball: the Gauss points of one group's elements (one layer: stresses
+// jump across layer interfaces and are averaged within a layer only) with their volumes; centres at
+// the elements' centroids and the nodes, so that a ball also sits on the lumen, where a layer's stress
+// peaks (with centroids alone the best ball's centre moves with the element size: 4 % between the
+// generic artery's two finest meshes under blood pressure alone, against 0.9 % with the nodes and
+// the Gauss points). Neighbours through a uniform grid of cells of size `radius`; cost O(centres ·
+// points per ball). radius ≤ 0 or non-finite: invalid_argument.
+std::vector<double> ball_average(const std::vector<Vec3d>& centre, const std::vector<Vec3d>& point,
+                                 const std::vector<double>& value, const std::vector<double>& weight, double radius);
 
 }  // namespace angio::solid
