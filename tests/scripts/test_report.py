@@ -60,6 +60,8 @@ MEDIA_MAX_NODAL = [0.0, 0.0030, 0.0033, 4.0, 12.5, 2.0, 0.31]
 MEDIA_P99_NODAL = [0.0, 0.0025, 0.0028, 1.6, 4.4, 0.8, 0.12]
 MEDIA_ENDO_NODAL = [0.0, 0.0030, 0.0033, 4.0, 12.0, 1.9, 0.30]
 ADV_MAX_NODAL = [0.0, 0.0002, 0.00021, 0.025, 0.06, 0.035, 0.016]
+# averaged over the ball of stress_average_radius (*_averaged keys): below the element maxima at a strut
+MEDIA_AVG = [0.0, 0.0019, 0.0022, 1.3, 4.2, 0.7, 0.12]
 U_ARTERY = [0.0, 0.12, 0.13, 0.2, 0.3, 0.28, 0.27]
 STENT_D = [1.15, 1.15, 1.16, 1.6, 2.14, 2.16, 1.90]  # beam max (2.16) is not at the peak
 STATIONS = [-5.5 + i for i in range(12)]  # mm, stent spans -3 .. 3
@@ -100,6 +102,7 @@ def make_artery_run(run):
             "max_principal_stress_nodal_at": {"balloon": [0, 0, 3], "media": [0.79, 0, 3], "adventitia": [1.1, 0, 3]},
             # only the layer that touches the lumen
             "max_principal_stress_endothelium_nodal": {"media": MEDIA_ENDO_NODAL[i]},
+            "max_principal_stress_averaged": {"balloon": 0.9, "media": MEDIA_AVG[i], "adventitia": None},
             "max_displacement": {"balloon": 0.5 * i, "artery": U_ARTERY[i]},
             "balloon_outer_diameter": {"mid": 1.0, "end0": 1.1, "end1": 1.1, "dogboning": 0.01 * i},
         }
@@ -128,6 +131,7 @@ def make_artery_run(run):
         ],
         "lumen_stations": STATIONS,
         "apposition_threshold": 0.1,
+        "stress_average_radius": 0.25,
         "steps": steps,
     }
     write(run / "solid" / "summary.json", json.dumps(solid, indent=1))
@@ -349,6 +353,18 @@ class ArteryReport(unittest.TestCase):
         adv = self.res["artery"]["phases"]["peak"]["layers"]["adventitia"]
         self.assertIsNone(adv["max_principal_stress_endothelium_nodal"])
         self.assertIsNone(adv["paper_max_principal_stress_endothelium"])
+
+    def test_averaged_stress_rows(self):
+        # the ball average: a row per phase and layer where the solid wrote one, named with its radius
+        self.assertAlmostEqual(self.ours("peak: media max principal stress, averaged over 0.25 mm (kPa)"), 4200.0)
+        self.assertAlmostEqual(self.ours("after: media max principal stress, averaged over 0.25 mm (kPa)"), 120.0)
+        self.assertAlmostEqual(self.ours("prestressed: media max principal stress, averaged over 0.25 mm (kPa)"), 2.2)
+        self.assertNotIn("peak: adventitia max principal stress, averaged over 0.25 mm (kPa)", self.rows)  # null
+        self.assertFalse(any("balloon" in n and "averaged" in n for n in self.rows))  # artery layers only
+        self.assertEqual(self.res["artery"]["stress_average_radius"], 0.25)
+        self.assertAlmostEqual(
+            self.res["artery"]["phases"]["peak"]["layers"]["media"]["max_principal_stress_averaged"], 4.2
+        )
 
     def test_lumen_and_apposition(self):
         self.assertAlmostEqual(self.ours("min lumen diameter after, stented (mm)"), 1.85)

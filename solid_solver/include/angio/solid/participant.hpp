@@ -125,6 +125,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::unique_ptr<StressRecovery> recovery_;     // recovered nodal stresses per layer
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
   double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
+  double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (rank 0): max, p99, ball average
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
