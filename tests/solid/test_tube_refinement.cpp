@@ -10,8 +10,10 @@
 #include <vector>
 
 #include "angio/solid/mesh.hpp"
+#include "hex_volume.hpp"
 
 using namespace angio::solid;
+using angio::solid::test::hex_volume;
 
 namespace {
 TubeSpec tube() {
@@ -24,16 +26,6 @@ TubeSpec tube() {
   t.n_circ = 24;
   t.n_axial = 22;
   return t;
-}
-double hex_volume(const Mesh& m, const Element& e) {
-  static const int tets[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6}, {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-  double v = 0.0;
-  for (const auto& t : tets) {
-    const Vec3d a = m.X[e.n[t[1]]] - m.X[e.n[t[0]]], b = m.X[e.n[t[2]]] - m.X[e.n[t[0]]],
-                c = m.X[e.n[t[3]]] - m.X[e.n[t[0]]];
-    v += a.dot(b.cross(c)) / 6.0;
-  }
-  return v;
 }
 double total_volume(const Mesh& m) {
   double v = 0.0;
