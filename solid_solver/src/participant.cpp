@@ -282,8 +282,23 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
   std::vector<std::vector<Vec3d>> centres(nb), points(nb);
   std::vector<char> has_node(nb * mesh.X.size(), 0);
   std::vector<double> best(nb, -std::numeric_limits<double>::infinity());
-  Eigen::VectorXd N;
-  Eigen::MatrixXd dN;
+  // shape functions at the Gauss points and their volume shares w_q / Σw, once per element type
+  std::map<ElemType, std::pair<std::vector<Eigen::VectorXd>, std::vector<double>>> at_gauss;
+  auto gauss_of = [&](ElemType t) -> const auto& {
+    auto [it, fresh] = at_gauss.try_emplace(t);
+    if (fresh) {
+      const auto& rule = volume_rule(t);
+      double wsum = 0.0;
+      for (const auto& q : rule) wsum += q.w;
+      Eigen::MatrixXd dN;
+      for (const auto& q : rule) {
+        it->second.first.emplace_back();
+        shape(t, q.xi, it->second.first.back(), dN);
+        it->second.second.push_back(q.w / wsum);
+      }
+    }
+    return it->second;
+  };
   for (size_t k = 0; k + 2 < all.size(); k += 3) {
     const auto& el = mesh.elements[size_t(all[k])];
     const int b = el.block;
@@ -300,16 +315,13 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
       best[b] = v;
       s.stress[b].where = centres[b].back();
     }
-    const auto& rule = volume_rule(el.type);
-    double wsum = 0.0;
-    for (const auto& q : rule) wsum += q.w;
-    for (const auto& q : rule) {
-      shape(el.type, q.xi, N, dN);
+    const auto& [N, share] = gauss_of(el.type);
+    for (size_t q = 0; q < N.size(); ++q) {
       Vec3d x = Vec3d::Zero();
-      for (int a = 0; a < el.nn(); ++a) x += N(a) * model_->position(el.n[a]);
+      for (int a = 0; a < el.nn(); ++a) x += N[q](a) * model_->position(el.n[a]);
       points[b].push_back(x);
       point_value[b].push_back(v);
-      point_weight[b].push_back(volume * q.w / wsum);
+      point_weight[b].push_back(volume * share[q]);
     }
   }
   for (size_t b = 0; b < nb; ++b) {
@@ -489,10 +501,11 @@ void SolidRunner::write_summary_json_() const {
       "(with the current centroid of that element) and the 99th percentile by reference volume";
   j["stress_average_radius"] = scene_.stress_average_radius;
   j["stress_measure_averaged"] =
-      "first principal Cauchy stress of the elements (as stress_measure) averaged by reference volume over the "
-      "elements of the same block whose current centroids lie within stress_average_radius (mm) of an element's "
-      "centroid; per block the max over its elements (with that element's centroid): converges under refinement "
-      "where the element max and p99 at a strut do not (docs/validation.md)";
+      "first principal Cauchy stress of the elements (as stress_measure) averaged over a ball of radius "
+      "stress_average_radius (mm) within the block, sampled at the block's Gauss points in the current configuration "
+      "(each with its element's value and its share of the element's reference volume); per block the max over balls "
+      "centred at its element centroids and nodes (with that centre): converges under refinement where the element "
+      "max and p99 at a strut do not (docs/validation.md, mesh ladder)";
   j["stress_measure_nodal"] =
       "first principal Cauchy stress of the recovered nodal tensor: L2 projection (consistent mass, reference "
       "configuration) of the Gauss-point Cauchy tensor onto the nodes of each block separately, so a node on a layer "

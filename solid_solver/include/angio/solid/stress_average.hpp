@@ -23,8 +23,8 @@ namespace angio::solid {
 // the elements' centroids and the nodes, so that a ball also sits on the lumen, where a layer's stress
 // peaks (with centroids alone the best ball's centre moves with the element size: 4 % between the
 // generic artery's two finest meshes under blood pressure alone at 0.25 mm, against 0.9 % with the nodes and
-// the Gauss points). Neighbours through a uniform grid of cells of size `radius`; cost O(centres ·
-// points per ball). radius ≤ 0 or non-finite: invalid_argument.
+// the Gauss points). Neighbours through the contact search's AABB tree (contact/search.hpp); cost
+// O(centres · (log points + points per ball)). radius ≤ 0 or non-finite: invalid_argument.
 std::vector<double> ball_average(const std::vector<Vec3d>& centre, const std::vector<Vec3d>& point,
                                  const std::vector<double>& value, const std::vector<double>& weight, double radius);
 
