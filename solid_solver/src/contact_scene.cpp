@@ -83,6 +83,7 @@ ContactSpec read_contact_spec(const Node& root) {
   if (!(spec.line_regularization < 0.5 * spec.search_radius))
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
   spec.line_averaged_normals = c->get<std::string>("line_normals") == "averaged";
+  spec.line_ring_tangent = c->get<std::string>("line_tangent") == "ring";
   spec.log = c->get<bool>("log");
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);
@@ -124,6 +125,7 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   so.search_radius = spec.search_radius;
   so.regularization = spec.line_regularization;
   so.averaged_normals = spec.line_averaged_normals;
+  so.ring_tangent = spec.line_ring_tangent;
   if (has_balloon) so.balloon_penalty = spec.stent_balloon;
   if (has_artery) so.artery_penalty = spec.stent_artery;
   so.balloon_from = spec.stent_balloon_from;

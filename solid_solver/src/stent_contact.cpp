@@ -112,6 +112,7 @@ PenaltyStentContact::~PenaltyStentContact() = default;
 void PenaltyStentContact::set_points(const participant::SamplePoints& pts) {
   if (pts.w.size() != pts.x.size() || pts.radius.size() != pts.x.size())
     throw std::runtime_error("stent contact: sample points need x, w and radius of equal length");
+  last_eval_.clear();
   points_.resize(pts.x.size());
   for (size_t i = 0; i < pts.x.size(); ++i)
     points_[i] = contact::BeamPoint{contact::Vec3(pts.x[i][0], pts.x[i][1], pts.x[i][2]), pts.w[i], pts.radius[i]};
@@ -133,6 +134,7 @@ std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const Sol
     par.penalty = on_(k, model) ? penalty_[k] : 0.0;
     par.regularization = opt_.regularization;
     par.averaged_normals = opt_.averaged_normals;
+    par.ring_tangent = opt_.ring_tangent;
     par.compute_tangent = tangent;
     per_surface.push_back(contact::evaluate_line_contact(points, one, par));
   }
@@ -146,18 +148,25 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   std::size_t lo, hi;
   slice(points_.size(), model.rank(), model.size(), lo, hi);
   contact::ContactDiagnostics diag;
-  for (const auto& res : evaluate_(model, std::span(points_).subspan(lo, hi - lo), K != nullptr, false)) {
+  auto per_surface = evaluate_(model, std::span(points_).subspan(lo, hi - lo), K != nullptr, false);
+  for (auto& res : per_surface) {
     insert(model, res.solid, r, K);
     diag.merge(res.diag);
+    res.solid.clear();  // the reply needs the points' results only
   }
   last_ = reduce_summary(diag, 0.0, opt_.search_radius, model.comm(), nullptr);
+  last_eval_.clear();
+  if (hi - lo == points_.size() && per_surface.size() == searches_.size()) {
+    last_eval_ = std::move(per_surface);
+    last_eval_coords_ = coords_;
+  }
   timing_.calls++;
   timing_.seconds += MPI_Wtime() - t0;
 }
 
 std::vector<NodeCoupling> PenaltyStentContact::couplings(const SolidModel& model) const {
   std::vector<NodeCoupling> out;
-  if (!opt_.averaged_normals) return out;
+  if (!opt_.averaged_normals || !opt_.ring_tangent) return out;  // face columns: the elements' pattern has them
   for (const auto& surface : surfaces_) {
     const auto ring = contact::node_rings(*surface, model.mesh().X.size());
     for (const auto& f : surface->faces) {
@@ -179,7 +188,11 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.n_active = 0;
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
-  const auto per_surface = evaluate_(model, points_, false, true);  // every rank: identical data, no communication
+  // every rank: identical data, no communication; the last assembly's when it saw this configuration
+  gather_coords(model, coords_);
+  const bool reuse = !last_eval_.empty() && coords_ == last_eval_coords_;
+  const auto per_surface = reuse ? std::move(last_eval_) : evaluate_(model, points_, false, true);
+  last_eval_.clear();
   if (per_surface.empty()) return;
   // robin data: one plane per point and surface (K = number of surfaces, point-major), eps = 0 where
   // the surface has no face within the search radius

@@ -1,4 +1,6 @@
 // Line contact along the averaged nodal normal field (normal_field.hpp, LineContactParams::averaged_normals).
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "helpers.hpp"
@@ -66,6 +68,22 @@ test::Mesh groove(double angle) {
   test::Mesh m = flat_quads(4, 2, 0.1, 0.1, 0.0, -0.2, 0.0);
   for (Vec3& x : m.x) x.z() = std::tan(angle) * std::abs(x.x());
   return m;
+}
+
+// A quarter cylinder (R = 0.55 mm) of quad4 or tri6 faces, every node moved by up to 0.01 mm (seeded).
+test::Mesh perturbed_quarter_cylinder(FaceKind kind, unsigned seed) {
+  test::Mesh m = cylinder(kind, 0.55, 0.6, 10, 3, 0.0, M_PI / 2);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (Vec3& x : m.x) x += 0.01 * Vec3(U(rng), U(rng), U(rng));
+  return m;
+}
+
+// 12 stent points (R = 0.06 mm) along a helix at radius 0.59 mm: pressed about 0.02 mm into that cylinder.
+std::vector<BeamPoint> helix_points() {
+  std::vector<BeamPoint> pts;
+  for (int i = 0; i < 12; ++i) pts.push_back({cyl(0.59, 0.2 + 0.1 * i, 0.1 + 0.035 * i), 0.03, 0.06});
+  return pts;
 }
 }  // namespace
 
@@ -163,13 +181,9 @@ TEST(NormalField, LineLoadContinuousAcrossGroove) {
 // normals of the nodes around each face (NodeNormal::dn) is checked with the search and the assembly layout.
 TEST(NormalField, AssembledTangentMatchesFiniteDifferences) {
   for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
-    test::Mesh m = cylinder(kind, 0.55, 0.6, 10, 3, 0.0, M_PI / 2);
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<double> U(-1, 1);
-    for (Vec3& x : m.x) x += 0.01 * Vec3(U(rng), U(rng), U(rng));
+    const test::Mesh m = perturbed_quarter_cylinder(kind, 3);
     const int n = static_cast<int>(m.x.size());
-    std::vector<BeamPoint> pts;
-    for (int i = 0; i < 12; ++i) pts.push_back({cyl(0.59, 0.2 + 0.1 * i, 0.1 + 0.035 * i), 0.03, 0.06});
+    const std::vector<BeamPoint> pts = helix_points();
     auto assemble = [&](const Eigen::VectorXd& u, Eigen::MatrixXd* K) {
       std::vector<Vec3> x(n);
       for (int i = 0; i < n; ++i) x[i] = u.segment<3>(3 * i);
@@ -192,5 +206,36 @@ TEST(NormalField, AssembledTangentMatchesFiniteDifferences) {
     ASSERT_GT(r.norm(), 0.0);
     const Eigen::MatrixXd Kfd = fd_jacobian([&](const Eigen::VectorXd& v) { return assemble(v, nullptr); }, u, 1e-6);
     EXPECT_LT(rel_diff(K, Kfd), 1e-6) << name(kind);
+  }
+}
+
+// Compares against: the exact (ring) tangent, whose columns are checked against finite differences above.
+// Without the ring columns (LineContactParams::ring_tangent = false) every contribution keeps the face's own
+// nodes, with exactly the ring tangent's columns of those nodes, and the same residual.
+TEST(NormalField, FaceTangentIsTheRingTangentsFaceColumns) {
+  for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
+    const test::Mesh m = perturbed_quarter_cylinder(kind, 5);
+    const std::vector<BeamPoint> pts = helix_points();
+    SurfaceSearch S(m.surface, 0.3);
+    S.enable_normal_field();
+    S.update(m.x);
+    const SurfaceSearch* s[] = {&S};
+    LineContactParams par;
+    par.averaged_normals = true;
+    par.regularization = 0.005;
+    const LineContactResult ring = evaluate_line_contact(pts, s, par);
+    par.ring_tangent = false;
+    const LineContactResult face = evaluate_line_contact(pts, s, par);
+    ASSERT_EQ(ring.solid.size(), 12u);
+    ASSERT_EQ(face.solid.size(), ring.solid.size());
+    for (std::size_t i = 0; i < ring.solid.size(); ++i) {
+      const NodalContribution &a = ring.solid[i], &b = face.solid[i];
+      const Eigen::Index nn = b.r.size() / 3;
+      EXPECT_GT(a.nodes.size(), std::size_t(nn)) << name(kind);  // the ring tangent reaches beyond the face
+      ASSERT_EQ(b.nodes.size(), std::size_t(nn)) << name(kind);
+      EXPECT_TRUE(std::equal(b.nodes.begin(), b.nodes.end(), a.nodes.begin())) << name(kind);
+      EXPECT_EQ(b.r, a.r) << name(kind);
+      EXPECT_EQ(b.K, a.K.leftCols(3 * nn)) << name(kind);
+    }
   }
 }

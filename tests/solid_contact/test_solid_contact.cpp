@@ -135,8 +135,9 @@ TEST(StentContact, SinglePointForceBalance) {
 // (1b) The same through SolidRunner and the scene's contact: section: a ring of beam points pressing the balloon
 // inward is solved to equilibrium; at the converged state the contact residual (added into a fresh vector)
 // balances the reply's sum w q (force balance), and the balloon moves inward under the points.
-TEST(StentContact, RunnerRingOfPointsConverges) {
-  const char* yaml = R"(
+// A balloon tube (16 x 8 hex8) with stent-balloon contact; `contact_keys`: further keys of contact:.
+std::string ring_scene(const std::string& contact_keys) {
+  return R"(
 time: {end: 1.0, steps: 1}
 balloon:
   mesh: {generator: tube, length: 2.0, outer_diameter: 0.98, wall: 0.04, n_circ: 16, n_axial: 8}
@@ -146,23 +147,34 @@ contact:
   stent_balloon: {penalty: 10.0}
   search_radius: 0.3
   log: false
+)" + contact_keys +
+         R"(
 solid:
   petsc_options: "-ksp_rtol 1e-12"
   newton: {rtol: 1.0e-10, atol: 1.0e-12}
 )";
-  const angio::scene::Node root(YAML::Load(yaml), "inline.yaml", "");
+}
+
+// 24 beam points on a ring 0.03 mm inside the balloon's nodal radius, at z = 0.13 mm + wobble sin(3a).
+participant::SamplePoints ring_points(double wobble) {
+  participant::SamplePoints pts;
+  const double R = 0.06, r_beam = 0.49 + R - 0.03;
+  for (int i = 0; i < 24; ++i) {
+    const double a = 2 * M_PI * (i + 0.3) / 24;
+    pts.x.push_back({r_beam * std::cos(a), r_beam * std::sin(a), 0.13 + wobble * std::sin(3.0 * a)});
+    pts.w.push_back(0.1);
+    pts.radius.push_back(R);
+  }
+  return pts;
+}
+
+TEST(StentContact, RunnerRingOfPointsConverges) {
+  const angio::scene::Node root(YAML::Load(ring_scene("")), "inline.yaml", "");
   SolidRunner runner(PETSC_COMM_WORLD, read_solid_scene(root), "");
   auto setup = make_contact(root, runner);
   ASSERT_NE(setup->stent(), nullptr);
   EXPECT_EQ(setup->balloon_artery(), nullptr);
-  participant::SamplePoints pts;
-  const double R = 0.06, r_beam = 0.49 + R - 0.03;  // 0.03 mm initial penetration at the nodal radius
-  for (int i = 0; i < 24; ++i) {
-    const double a = 2 * M_PI * (i + 0.3) / 24;
-    pts.x.push_back({r_beam * std::cos(a), r_beam * std::sin(a), 0.13});
-    pts.w.push_back(0.1);
-    pts.radius.push_back(R);
-  }
+  const participant::SamplePoints pts = ring_points(0.0);
   participant::ContactReply reply;
   runner.begin_step(1, 1.0);
   const auto st = runner.solve(pts, reply, 0.0);
@@ -182,7 +194,53 @@ solid:
   const auto rs = component_sums(r);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(rs[c], reply.total_force[c], 1e-13) << c;
   VecDestroy(&r);
+  // The reply took the converged Newton's last evaluation (one rank) or evaluated again (each rank held a
+  // slice): either way it is the contact of the final configuration, bit for bit a fresh evaluation's.
+  participant::ContactReply fresh;
+  reset_reply(pts, fresh);
+  setup->stent()->set_points(pts);  // drops any kept evaluation
+  setup->stent()->fill_reply(runner.model(), fresh);
+  EXPECT_EQ(fresh.line_loads, reply.line_loads);
+  EXPECT_EQ(fresh.surface_points, reply.surface_points);
+  EXPECT_EQ(fresh.normals, reply.normals);
+  EXPECT_EQ(fresh.penalty, reply.penalty);
+  EXPECT_EQ(fresh.n_active, reply.n_active);
   runner.end_step(true);
+}
+
+// (1c) Consistency of contact.line_tangent: the face tangent (default) leaves out columns of the averaged
+// normals' exact tangent but not of the residual, so a Newton with it converges to the state of a Newton
+// with the exact (ring) tangent: the same ring of points pressing the balloon gives the same line loads to
+// the Newton tolerance, the face tangent in no fewer iterations (it is not exact).
+TEST(StentContact, FaceTangentConvergesToTheRingTangentsState) {
+  auto solve = [](const char* tangent, int& iterations) {
+    const std::string keys = std::string("  line_normals: averaged\n  line_tangent: ") + tangent + "\n";
+    const angio::scene::Node root(YAML::Load(ring_scene(keys)), "inline.yaml", "");
+    SolidRunner runner(PETSC_COMM_WORLD, read_solid_scene(root), "");
+    auto setup = make_contact(root, runner);
+    const participant::SamplePoints pts = ring_points(0.01);
+    participant::ContactReply reply;
+    runner.begin_step(1, 1.0);
+    const auto st = runner.solve(pts, reply, 0.0);
+    EXPECT_TRUE(st.converged) << tangent << ": " << st.message;
+    EXPECT_EQ(reply.n_active, 24) << tangent;
+    iterations = st.iterations;
+    runner.end_step(true);
+    return reply.line_loads;
+  };
+  int it_ring = 0, it_face = 0;
+  const auto ring = solve("ring", it_ring);
+  const auto face = solve("face", it_face);
+  ASSERT_EQ(ring.size(), face.size());
+  double diff = 0, scale = 0;
+  for (size_t i = 0; i < ring.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      diff = std::max(diff, std::abs(ring[i][c] - face[i][c]));
+      scale = std::max(scale, std::abs(ring[i][c]));
+    }
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LT(diff, 1e-8 * scale);
+  EXPECT_GE(it_face, it_ring);
 }
 
 // Three stent points (radius 0.06 mm) pressed 5 um into faces 3, 14 and 22 of the balloon's outer surface.
@@ -211,6 +269,7 @@ void check_model_tangent(bool averaged_normals) {
   so.balloon_penalty = 10.0;
   so.artery_penalty = 8.0;
   so.averaged_normals = averaged_normals;
+  so.ring_tangent = true;  // the exact tangent
   PenaltyStentContact stent(model, so);
   PenaltySurfaceContact::Options bo;
   bo.penalty = 5.0;
@@ -289,13 +348,18 @@ TEST(StentContact, TangentMatchesFiniteDifferencesAveragedNormals) { check_model
 // itself for every entry outside its pattern). Consistency property of the assembly, on 1 and 2 ranks:
 // without PenaltyStentContact::couplings() the rings (4 x 4 surface nodes around a quad4 face) reach
 // past the hex8 elements' pattern and the count is positive.
-TEST(StentContact, AveragedNormalsTangentFitsThePattern) {
+// With the face tangent (contact.line_tangent: face, the default) nothing is declared and nothing is
+// allocated either: the matrix holds exactly the elements' entries, as without contact.
+void check_averaged_pattern(bool ring) {
   Mesh m = tube("balloon", 0.44, 0.04, 1.2, 10, 3);
   SolidModel model(PETSC_COMM_WORLD, m, {neo_hooke("balloon", 1.0, 0.3)}, tight_options());
+  MatInfo bare;
+  MatGetInfo(model.matrix(), MAT_GLOBAL_SUM, &bare);
   const participant::SamplePoints pts = pressed_into_balloon(model.mesh());
   PenaltyStentContact::Options so;
   so.balloon_penalty = 10.0;
   so.averaged_normals = true;
+  so.ring_tangent = ring;
   PenaltyStentContact stent(model, so);
   model.set_contact(&stent);
   stent.set_points(pts);
@@ -304,7 +368,14 @@ TEST(StentContact, AveragedNormalsTangentFitsThePattern) {
   MatInfo info;
   MatGetInfo(model.matrix(), MAT_GLOBAL_SUM, &info);
   EXPECT_EQ(info.mallocs, 0.0);
+  if (ring)
+    EXPECT_GT(info.nz_allocated, bare.nz_allocated);
+  else
+    EXPECT_EQ(info.nz_allocated, bare.nz_allocated);
 }
+
+TEST(StentContact, AveragedNormalsTangentFitsThePattern) { check_averaged_pattern(true); }
+TEST(StentContact, AveragedNormalsFaceTangentKeepsTheElementsPattern) { check_averaged_pattern(false); }
 
 // Cost of the stent contact in an assembly (printed): 1260 sample points (4-ring stent: 210 elements x 6) on a
 // helix pressing 2 um into the paper's balloon (22 x 58 hex8); compared with the whole assembly (elements +
@@ -495,6 +566,9 @@ TEST(ContactScene, ReadsAndValidates) {
   EXPECT_NE(error("contact: {balloon_artery: {regularization: 0.2}}").find("contact.balloon_artery.regularization"),
             std::string::npos);
   EXPECT_NE(error("contact: {stent_artery: maybe}").find("contact.stent_artery"), std::string::npos);
+  EXPECT_NE(error("contact: {line_tangent: full}").find("contact.line_tangent"), std::string::npos);
+  EXPECT_FALSE(read_contact_spec(node("time: {end: 1}")).line_ring_tangent);  // face: the default
+  EXPECT_TRUE(read_contact_spec(node("contact: {line_tangent: ring}")).line_ring_tangent);
 }
 
 // The shipped scene parses (solid parts + contact section) and enables balloon-artery contact.

@@ -101,13 +101,16 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
 namespace {
 // Turns the averaged kernel's tangent over [face nodes | face nodal normals] into one over the face nodes
 // followed by the other nodes of their rings: K_ring += K_n,b dn_b/dX_ring (NodeNormal::dn). The residual
-// stays on the face nodes (NodalContribution: rows = the first r.size()/3 nodes).
-void chain_normals(const Face& face, const SurfaceSearch& S, NodalContribution& nc) {
+// stays on the face nodes (NodalContribution: rows = the first r.size()/3 nodes). Without `ring`, the
+// columns of ring nodes outside the face are left out (LineContactParams::ring_tangent).
+void chain_normals(const Face& face, const SurfaceSearch& S, bool ring, NodalContribution& nc) {
   const int nn = face.nn();
   nc.nodes.assign(face.nodes.begin(), face.nodes.begin() + nn);
+  // column of node id; -1: a ring node outside the face, left out
   auto index = [&](int id) {
     const auto it = std::find(nc.nodes.begin(), nc.nodes.end(), id);
     if (it != nc.nodes.end()) return int(it - nc.nodes.begin());
+    if (!ring) return -1;
     nc.nodes.push_back(id);
     return int(nc.nodes.size()) - 1;
   };
@@ -119,7 +122,7 @@ void chain_normals(const Face& face, const SurfaceSearch& S, NodalContribution& 
     const NodeNormal& nb = S.node_normal(face.nodes[b]);
     const auto Kn = nc.K.middleCols<3>(3 * nn + 3 * b);
     for (std::size_t j = 0; j < nb.ring.size(); ++j)
-      K.middleCols<3>(3 * index(nb.ring[j])) += Kn * nb.dn.middleCols<3>(3 * j);
+      if (const int col = index(nb.ring[j]); col >= 0) K.middleCols<3>(3 * col) += Kn * nb.dn.middleCols<3>(3 * j);
   }
   nc.K = std::move(K);
 }
@@ -146,7 +149,7 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
         pc.face = sp.face;
         line_point_kernel_averaged(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), S.face_normals(sp.face),
                                    sp.proj, par, pc, nc.r, K);
-        if (pc.active && K) chain_normals(surf.faces[sp.face], S, nc);
+        if (pc.active && K) chain_normals(surf.faces[sp.face], S, par.ring_tangent, nc);
       } else {
         const SurfaceProjection sp = S.closest(bp.x, par.projection);
         if (!sp.found) continue;

@@ -24,6 +24,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <unordered_set>
 #include <vector>
 
@@ -64,6 +65,8 @@ class PenaltyStentContact : public StentContact {
     double search_radius = scene::keys::defaults::contact_search_radius;  // mm; > R + the largest penetration
     double regularization = 0.0;    // g0 (mm) of the linear-quadratic law (line_contact.hpp)
     bool averaged_normals = false;  // projection along the averaged normal field (line_contact.hpp)
+    bool ring_tangent =             // LineContactParams::ring_tangent (averaged normals only)
+        std::string_view(scene::keys::defaults::contact_line_tangent) == "ring";
     std::string balloon_surface = "balloon_outer";
     std::string artery_surface = "artery_inner";
     double balloon_from = kAlwaysActive, artery_from = kAlwaysActive;  // s: off before these times
@@ -103,6 +106,11 @@ class PenaltyStentContact : public StentContact {
   std::vector<std::unique_ptr<contact::SurfaceSearch>> searches_;
   std::vector<contact::BeamPoint> points_;
   std::vector<contact::Vec3> coords_;
+  // The last add()'s evaluation when it covered every point and surface (one rank, every pair on), and
+  // the coordinates it saw: fill_reply() at the same configuration (a converged Newton's last residual)
+  // takes it instead of evaluating again. Dropped by set_points().
+  std::vector<contact::LineContactResult> last_eval_;
+  std::vector<contact::Vec3> last_eval_coords_;
   ContactSummary last_;
   ContactTiming timing_;
 };

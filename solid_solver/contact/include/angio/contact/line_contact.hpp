@@ -41,6 +41,13 @@ struct LineContactParams {
   //   q = f(g) nu, f_a = -w q N_a(xi), g = d - R, and K is the tangent with the nodal normals held
   //   fixed (not symmetric).
   bool averaged_normals = false;
+  // averaged normals only. true: K over the face's nodes and the other nodes of their rings (the
+  // nodal normals' dependence on every node they average over). false: K over the face's own nodes
+  // only (the columns of the other ring nodes left out, the face nodes' columns exact); the residual
+  // is the same, so a Newton with this tangent converges to the same solution. The ring columns
+  // widen the solid's matrix pattern to the surface's second neighbours, which makes its direct
+  // factorization 2.5x dearer on a balloon one element thick (docs/performance.md).
+  bool ring_tangent = true;
   bool compute_tangent = true;  // fill NodalContribution::K
   bool beam_tangent = false;    // fill PointContact::dq_dx
   ProjectionOptions projection;
