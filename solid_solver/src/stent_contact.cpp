@@ -128,7 +128,7 @@ std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const Sol
   gather_coords(model, coords_);
   for (size_t k = 0; k < searches_.size(); ++k) {
     if (!all && !on_(k, model)) continue;
-    searches_[k]->update(coords_, /*rebuild=*/true);
+    searches_[k]->update(coords_, /*rebuild=*/true, /*normal_derivatives=*/tangent);
     const contact::SurfaceSearch* one[] = {searches_[k].get()};
     contact::LineContactParams par;
     par.penalty = on_(k, model) ? penalty_[k] : 0.0;

@@ -239,3 +239,32 @@ TEST(NormalField, FaceTangentIsTheRingTangentsFaceColumns) {
     }
   }
 }
+
+// Consistency: an update without the normals' derivatives (what a residual-only evaluation asks for) gives the
+// same normals, residual and loads as one with them, and a tangent from it is refused instead of being built
+// from stale derivatives.
+TEST(NormalField, UpdateWithoutDerivativesSameResidualTangentRefused) {
+  const test::Mesh m = perturbed_quarter_cylinder(FaceKind::Quad4, 7);
+  const std::vector<BeamPoint> pts = helix_points();
+  SurfaceSearch full(m.surface, 0.3), bare(m.surface, 0.3);
+  full.enable_normal_field();
+  bare.enable_normal_field();
+  full.update(m.x);
+  bare.update(m.x, true, false);
+  EXPECT_TRUE(full.normal_derivatives());
+  EXPECT_FALSE(bare.normal_derivatives());
+  LineContactParams par;
+  par.averaged_normals = true;
+  par.regularization = 0.005;
+  par.compute_tangent = false;
+  const SurfaceSearch* a[] = {&full};
+  const SurfaceSearch* b[] = {&bare};
+  const LineContactResult ra = evaluate_line_contact(pts, a, par), rb = evaluate_line_contact(pts, b, par);
+  ASSERT_EQ(ra.solid.size(), 12u);
+  ASSERT_EQ(rb.solid.size(), ra.solid.size());
+  for (std::size_t i = 0; i < ra.solid.size(); ++i) EXPECT_EQ(rb.solid[i].r, ra.solid[i].r);
+  EXPECT_EQ(rb.q, ra.q);
+  par.compute_tangent = true;
+  EXPECT_THROW(evaluate_line_contact(pts, b, par), std::logic_error);
+  EXPECT_NO_THROW(evaluate_line_contact(pts, a, par));
+}

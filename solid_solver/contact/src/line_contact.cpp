@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 
 #include "angio/participant/penalty_law.hpp"
 
@@ -136,6 +137,10 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
     const SurfaceSearch& S = *surfaces[k];
     const Surface& surf = S.surface();
+    if (par.averaged_normals && par.compute_tangent && !S.normal_derivatives())
+      throw std::logic_error(
+          "evaluate_line_contact: a tangent along the normal field needs SurfaceSearch::update() "
+          "with the normals' derivatives");
     auto& pcs = res.per_surface[k];
     pcs.assign(points.size(), PointContact{});
     for (std::size_t i = 0; i < points.size(); ++i) {

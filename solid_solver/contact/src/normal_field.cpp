@@ -26,7 +26,8 @@ std::vector<std::vector<int>> node_rings(const Surface& s, std::size_t num_nodes
   return rings;
 }
 
-void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out) {
+void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out,
+                   bool derivatives) {
   // v_a = sum over faces f at a of t_f(a) = c / |c|, c = x_,xi x x_,eta of f at a (times normal_sign);
   // dc/dX_b = d_area_vector (face.hpp), dt = (I - t t^T) dc / |c|, n_a = v_a / |v_a|.
   if (out.node.size() != num_nodes || out.face.size() != s.faces.size()) {
@@ -36,9 +37,10 @@ void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_n
     out.face.assign(s.faces.size(), FaceX());
     for (std::size_t f = 0; f < s.faces.size(); ++f) out.face[f].resize(3, s.faces[f].nn());
   }
+  out.derivatives = derivatives;
   for (NodeNormal& nn : out.node) {
     nn.n.setZero();  // accumulates v_a first
-    nn.dn.setZero(3, 3 * Eigen::Index(nn.ring.size()));
+    if (derivatives) nn.dn.setZero(3, 3 * Eigen::Index(nn.ring.size()));
   }
   for (std::size_t f = 0; f < s.faces.size(); ++f) {
     const Face& face = s.faces[f];
@@ -53,6 +55,7 @@ void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_n
       const Mat3 P = (Mat3::Identity() - t * t.transpose()) / cn;
       NodeNormal& nn = out.node[face.nodes[a]];
       nn.n += t;
+      if (!derivatives) continue;
       for (int b = 0; b < face.nn(); ++b) {
         const auto col = std::find(nn.ring.begin(), nn.ring.end(), face.nodes[b]) - nn.ring.begin();
         nn.dn.middleCols<3>(3 * col) += s.normal_sign * P * d_area_vector(dN(b, 0), dN(b, 1), a1, a2);
@@ -63,6 +66,7 @@ void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_n
     if (nn.ring.empty()) continue;
     const double vn = nn.n.norm();
     nn.n /= vn;
+    if (!derivatives) continue;
     const Mat3 P = (Mat3::Identity() - nn.n * nn.n.transpose()) / vn;
     for (Eigen::Index j = 0; j < nn.dn.cols(); j += 3) nn.dn.middleCols<3>(j) = (P * nn.dn.middleCols<3>(j)).eval();
   }

@@ -109,7 +109,7 @@ SurfaceSearch::SurfaceSearch(const Surface& surface, double radius, bool reject_
   }
 }
 
-void SurfaceSearch::update(std::span<const Vec3> coords, bool rebuild) {
+void SurfaceSearch::update(std::span<const Vec3> coords, bool rebuild, bool normal_derivatives) {
   const auto& faces = surface_->faces;
   const bool same = ready_ && X_.size() == faces.size();
   X_.resize(faces.size());
@@ -119,7 +119,7 @@ void SurfaceSearch::update(std::span<const Vec3> coords, bool rebuild) {
     boxes_[f] = angio::contact::face_box(faces[f].kind, X_[f]);
     boxes_[f].inflate(radius_);
   }
-  if (normal_field_) nodal_normals(*surface_, X_, coords.size(), normals_);
+  if (normal_field_) nodal_normals(*surface_, X_, coords.size(), normals_, normal_derivatives);
   if (rebuild || !same)
     tree_.build(boxes_);
   else

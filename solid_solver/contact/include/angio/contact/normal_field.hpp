@@ -33,6 +33,7 @@ struct NodeNormal {
 struct NodalNormals {
   std::vector<NodeNormal> node;
   std::vector<FaceX> face;
+  bool derivatives = false;  // NodeNormal::dn holds the current configuration's
 };
 // The ring of every node id used by a face of `s` (ids index an array of num_nodes entries): the nodes
 // of the faces around it, itself included, in the order met; empty for the others. The nodes a nodal
@@ -40,8 +41,11 @@ struct NodalNormals {
 std::vector<std::vector<int>> node_rings(const Surface& s, std::size_t num_nodes);
 
 // `out` keeps its rings and storage between calls on the same surface (one call per Newton iteration):
-// the first call builds them, later calls only recompute the values.
-void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out);
+// the first call builds them, later calls only recompute the values. derivatives = false: the normals
+// only (NodeNormal::dn left stale, `out.derivatives` false); a residual needs no more, and the
+// derivatives are most of the cost.
+void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_nodes, NodalNormals& out,
+                   bool derivatives = true);
 
 struct NormalFieldProjection {
   bool valid = false;  // Newton converged and xi lies in the face (tolerance `inside_tol`)

@@ -55,8 +55,9 @@ class SurfaceSearch {
   // surface (d < 0) is rejected: such a point has passed beside the surface's rim, not through it
   // (see solid_solver/contact/README.md, "Free edges"). Disable with reject_behind_free_edges = false.
   SurfaceSearch(const Surface& surface, double radius, bool reject_behind_free_edges = true);
-  // Gather face coordinates from the current configuration, recompute boxes, rebuild (default) or refit the tree.
-  void update(std::span<const Vec3> coords, bool rebuild = true);
+  // Gather face coordinates from the current configuration, recompute boxes, rebuild (default) or refit the tree;
+  // with the normal field, the nodal normals and (normal_derivatives) their derivatives, which a tangent needs.
+  void update(std::span<const Vec3> coords, bool rebuild = true, bool normal_derivatives = true);
   // Faces whose box inflated by the radius contains p, sorted ascending.
   void candidates(const Vec3& p, std::vector<int>& faces) const;
   // Faces whose inflated box overlaps b, sorted ascending.
@@ -76,6 +77,7 @@ class SurfaceSearch {
   void enable_normal_field(bool on = true) { normal_field_ = on; }
   const FaceX& face_normals(int f) const { return normals_.face[f]; }
   const NodeNormal& node_normal(int id) const { return normals_.node[id]; }
+  bool normal_derivatives() const { return normals_.derivatives; }
   const Aabb& face_box(int f) const { return boxes_[f]; }  // inflated
   bool ready() const { return ready_; }
   // Bit e (0..3): edge e of face f is free; bit 4 + c: corner c lies on a free edge.
