@@ -23,6 +23,14 @@ void gather_coords(const SolidModel& model, std::vector<contact::Vec3>& coords) 
   for (int i = 0; i < n; ++i) coords[i] = model.position(i);
 }
 
+// Whether the model's node positions are bit for bit `coords` (the configuration an evaluation saw).
+bool same_positions(const SolidModel& model, const std::vector<contact::Vec3>& coords) {
+  if (coords.size() != model.mesh().X.size()) return false;
+  for (size_t i = 0; i < coords.size(); ++i)
+    if (coords[i] != model.position(int(i))) return false;
+  return true;
+}
+
 // Adds contributions (r = dPi/dX on the first r.size()/3 nodes, K = dr/dX over all nodes) with the model's global
 // dof numbers. Eigen's column-major K goes in as is: the model's Mat is column-oriented.
 void insert(const SolidModel& model, const std::vector<contact::NodalContribution>& cs, Vec r, Mat K) {
@@ -189,8 +197,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
   // every rank: identical data, no communication; the last assembly's when it saw this configuration
-  gather_coords(model, coords_);
-  const bool reuse = !last_eval_.empty() && coords_ == last_eval_coords_;
+  const bool reuse = !last_eval_.empty() && same_positions(model, last_eval_coords_);
   const auto per_surface = reuse ? std::move(last_eval_) : evaluate_(model, points_, false, true);
   last_eval_.clear();
   if (per_surface.empty()) return;

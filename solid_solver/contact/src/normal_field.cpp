@@ -52,10 +52,10 @@ void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_n
       const Vec3 c = s.normal_sign * a1.cross(a2);
       const double cn = c.norm();
       const Vec3 t = c / cn;
-      const Mat3 P = (Mat3::Identity() - t * t.transpose()) / cn;
       NodeNormal& nn = out.node[face.nodes[a]];
       nn.n += t;
       if (!derivatives) continue;
+      const Mat3 P = (Mat3::Identity() - t * t.transpose()) / cn;
       for (int b = 0; b < face.nn(); ++b) {
         const auto col = std::find(nn.ring.begin(), nn.ring.end(), face.nodes[b]) - nn.ring.begin();
         nn.dn.middleCols<3>(3 * col) += s.normal_sign * P * d_area_vector(dN(b, 0), dN(b, 1), a1, a2);

@@ -46,8 +46,7 @@ struct ContactSpec {
   double line_regularization = scene::keys::defaults::contact_line_regularization;
   bool line_averaged_normals =  // LineContactParams::averaged_normals
       std::string_view(scene::keys::defaults::contact_line_normals) == "averaged";
-  bool line_ring_tangent =  // LineContactParams::ring_tangent
-      std::string_view(scene::keys::defaults::contact_line_tangent) == "ring";
+  bool line_ring_tangent = kLineRingTangentDefault;  // LineContactParams::ring_tangent
   bool log = scene::keys::defaults::contact_log;
 };
 
