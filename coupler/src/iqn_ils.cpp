@@ -4,6 +4,7 @@
 
 #include "angio/common/log.hpp"
 #include "filtered_qr.hpp"
+#include "secant_rows.hpp"
 
 namespace angio::coupler {
 
@@ -18,6 +19,7 @@ IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) { check_i
 
 void IqnIls::begin_step() {
   current_ = Columns{};
+  jumped_.clear();
   r_prev_.resize(0);
   qt_prev_.resize(0);
 }
@@ -32,7 +34,10 @@ Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   if (k > 0 && r_prev_.size() == r.size()) {
     current_.v.insert(current_.v.begin(), r - r_prev_);
     current_.w.insert(current_.w.begin(), qt - qt_prev_);
+    drop_rows(current_.v.front(), jumped_);
+    drop_rows(current_.w.front(), jumped_);
   }
+  jumped_.clear();
   r_prev_ = r;
   qt_prev_ = qt;
 

@@ -2,6 +2,7 @@
 
 #include "angio/common/log.hpp"
 #include "filtered_qr.hpp"
+#include "secant_rows.hpp"
 
 namespace angio::coupler {
 
@@ -11,6 +12,7 @@ void IqnImvj::begin_step() {
   v_.clear();
   w_.clear();
   d_.clear();
+  jumped_.clear();
   r_prev_.resize(0);
   qt_prev_.resize(0);
   last_ = Correction{};
@@ -42,8 +44,11 @@ Eigen::VectorXd IqnImvj::update(const Eigen::VectorXd& q, const Eigen::VectorXd&
   if (k > 0 && r_prev_.size() == r.size()) {
     v_.insert(v_.begin(), r - r_prev_);
     w_.insert(w_.begin(), qt - qt_prev_);
+    drop_rows(v_.front(), jumped_);
+    drop_rows(w_.front(), jumped_);
     d_.insert(d_.begin(), w_.front() - apply_prev_(v_.front()));  // J_prev is fixed within the step
   }
+  jumped_.clear();
   r_prev_ = r;
   qt_prev_ = qt;
   std::vector<const Eigen::VectorXd*> vs;

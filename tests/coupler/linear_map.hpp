@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <vector>
 
 #include "angio/coupler/acceleration.hpp"
 
@@ -41,6 +42,32 @@ inline int run_step(angio::coupler::Acceleration& acc, const LinearMap& m, const
   }
   acc.end_step(false);
   return -1;
+}
+
+// `updates` updates of one step on the map extended by a component the map does not respond to
+// (its residual is 0 always, as the robin scheme's contact plane out of the stent's reach) and that
+// is set to `jump` before the second update, as a plane that appears at the edge of the search
+// radius is; with `mark` the acceleration is told (mark_discontinuous). The step is accepted.
+// Returns the iterates before each update (7 components, the free one last).
+inline std::vector<Eigen::VectorXd> iterates_with_appearing_component(Acceleration& acc, const LinearMap& m,
+                                                                      const Eigen::VectorXd& b, double jump, bool mark,
+                                                                      int updates) {
+  const Eigen::Index n = m.A.rows();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n + 1);
+  std::vector<Eigen::VectorXd> out;
+  acc.begin_step();
+  for (int k = 0; k < updates; ++k) {
+    if (k == 1) {
+      q[n] = jump;
+      if (mark) acc.mark_discontinuous({n});
+    }
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(n + 1);
+    r.head(n) = m.A * q.head(n) + b - q.head(n);
+    out.push_back(q);
+    q = acc.update(q, r, k);
+  }
+  acc.end_step(true);
+  return out;
 }
 
 }  // namespace angio::coupler::testing

@@ -20,6 +20,29 @@ TEST(Aitken, ScalarLinearMapConvergesAfterTwoUpdates) {
   EXPECT_NEAR(q[0], q_star, 1e-12);
 }
 
+TEST(Aitken, ComponentMarkedDiscontinuousStaysOutOfTheFactor) {
+  // The scalar map of the test above plus a component whose residual drops from 0.5 to 0 at the
+  // second update (a contact plane that vanished): marked, the second factor is the scalar map's
+  // own (the map's exact secant, so the scalar component reaches the fixed point); unmarked, the
+  // vanished residual enters the secant and the factor is wrong.
+  const double a = -5.0, b = 3.0, q_star = b / (1.0 - a);
+  for (const bool mark : {true, false}) {
+    Aitken acc(0.1, 1.0);
+    acc.begin_step();
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(2);
+    for (int k = 0; k < 2; ++k) {
+      Eigen::VectorXd r(2);
+      r << a * q[0] + b - q[0], k == 0 ? 0.5 : 0.0;
+      if (k == 1 && mark) acc.mark_discontinuous({1});
+      q = acc.update(q, r, k);
+    }
+    if (mark)
+      EXPECT_NEAR(q[0], q_star, 1e-12);
+    else
+      EXPECT_GT(std::abs(q[0] - q_star), 1e-3);
+  }
+}
+
 TEST(Aitken, FirstFactorOfAStepFollowsTheDesign) {
   Aitken acc(0.5, 2.0);
   acc.begin_step();

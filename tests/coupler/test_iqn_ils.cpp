@@ -27,6 +27,29 @@ TEST(IqnIls, LinearMapTerminatesInAtMostNPlusOneUpdates) {
   EXPECT_LT((q - m.fixed_point(b)).norm(), 1e-8);
 }
 
+TEST(IqnIls, ComponentMarkedDiscontinuousStaysOutOfTheModel) {
+  // A component set anew between two updates (a contact plane that appeared) is not the map's
+  // response: marked, the model neither moves it nor changes the other components' iterates (the
+  // same as without the component, to round-off); unmarked, its jump enters the secant column
+  // and the next update moves it although its residual is zero.
+  LinearMap m;
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(6, 1.0, 2.0);
+  const IqnIlsOptions o{0.1, 0, 100, 1e-10};
+  IqnIls marked(o), unmarked(o), plain(o);
+  const auto with = angio::coupler::testing::iterates_with_appearing_component(marked, m, b, 0.3, true, 6);
+  const auto without = angio::coupler::testing::iterates_with_appearing_component(unmarked, m, b, 0.3, false, 6);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+  plain.begin_step();
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_LT((with[k].head(6) - q).norm(), 1e-12 * (1.0 + q.norm())) << "update " << k;
+    if (k >= 1) {
+      EXPECT_EQ(with[k][6], 0.3) << "update " << k;
+    }
+    q = plain.update(q, m.A * q + b - q, k);
+  }
+  EXPECT_GT(std::abs(without[2][6] - 0.3), 1e-3);
+}
+
 TEST(IqnIls, AitkenCannotHandleModesOfBothSigns) {
   // The comparison that motivates IQN-ILS: one scalar factor cannot relax modes −6 and +4 at once.
   LinearMap m;

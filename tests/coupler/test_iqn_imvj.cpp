@@ -33,6 +33,30 @@ TEST(IqnImvj, WithoutCarriedJacobianItIsIqnIls) {
   EXPECT_LT((q2 - m.fixed_point(b)).norm(), 1e-8);
 }
 
+TEST(IqnImvj, ComponentMarkedDiscontinuousStaysOutOfTheModel) {
+  // as IqnIls.ComponentMarkedDiscontinuousStaysOutOfTheModel, over two steps: the carried Jacobian
+  // of the first does not move the component in the second either
+  LinearMap m;
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(6, 1.0, 2.0);
+  const IqnIlsOptions o{0.1, 4, 100, 1e-10};
+  IqnImvj marked(o), unmarked(o), plain(o);
+  for (int step = 0; step < 2; ++step) {
+    const auto with = angio::coupler::testing::iterates_with_appearing_component(marked, m, b, 0.3, true, 6);
+    const auto without = angio::coupler::testing::iterates_with_appearing_component(unmarked, m, b, 0.3, false, 6);
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
+    plain.begin_step();
+    for (int k = 0; k < 6; ++k) {
+      EXPECT_LT((with[k].head(6) - q).norm(), 1e-10 * (1.0 + q.norm())) << "step " << step << ", update " << k;
+      if (k >= 1) {
+        EXPECT_EQ(with[k][6], 0.3) << "step " << step << ", update " << k;
+      }
+      q = plain.update(q, m.A * q + b - q, k);
+    }
+    plain.end_step(true);
+    EXPECT_GT(std::abs(without[2][6] - 0.3), 1e-3) << "step " << step;
+  }
+}
+
 TEST(IqnImvj, CarriedJacobianSolvesTheNextStepWithTheFirstUpdate) {
   LinearMap m;
   IqnImvj acc(IqnIlsOptions{0.1, 4, 100, 1e-10});

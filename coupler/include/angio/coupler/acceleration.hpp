@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace angio::coupler {
 
@@ -20,6 +21,13 @@ class Acceleration {
   // Given the current input q_k and the residual r_k = q~_k − q_k of iteration k (0-based within
   // the step), returns the next input q_{k+1}.
   virtual Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) = 0;
+  // Components of the next update's q and r that were set anew since the last update instead of
+  // following the map (robin: a contact plane that appeared starts where the solid put it, one that
+  // vanished is no longer iterated). The secant difference the next update forms leaves them out
+  // (zero rows): a jump of up to the search radius would otherwise enter the model as the map's
+  // response (IQN: the least-squares step moved planes without force by as much; Aitken: its
+  // factor). Constant relaxation, without differences, ignores it.
+  virtual void mark_discontinuous(std::vector<Eigen::Index> components) { (void)components; }
   // Called when a step converged (e.g. to carry the last relaxation factor to the next step).
   virtual void end_step(bool accepted) = 0;
   // Relaxation factor used in the last update (for logging; 1 for schemes without one).
