@@ -4,7 +4,6 @@
 
 #include "angio/common/log.hpp"
 #include "filtered_qr.hpp"
-#include "secant_rows.hpp"
 
 namespace angio::coupler {
 
@@ -19,7 +18,6 @@ IqnIls::IqnIls(IqnIlsOptions o) : o_(o), factor_(o.initial_relaxation) { check_i
 
 void IqnIls::begin_step() {
   current_ = Columns{};
-  jumped_.clear();
   r_prev_.resize(0);
   qt_prev_.resize(0);
 }
@@ -31,13 +29,13 @@ void IqnIls::restart() {
 
 Eigen::VectorXd IqnIls::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) {
   const Eigen::VectorXd qt = q + r;
+  const std::vector<Eigen::Index> jumped = take_discontinuous();
   if (k > 0 && r_prev_.size() == r.size()) {
     current_.v.insert(current_.v.begin(), r - r_prev_);
     current_.w.insert(current_.w.begin(), qt - qt_prev_);
-    drop_rows(current_.v.front(), jumped_);
-    drop_rows(current_.w.front(), jumped_);
+    drop_rows(current_.v.front(), jumped);
+    drop_rows(current_.w.front(), jumped);
   }
-  jumped_.clear();
   r_prev_ = r;
   qt_prev_ = qt;
 

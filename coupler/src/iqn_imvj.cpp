@@ -2,7 +2,6 @@
 
 #include "angio/common/log.hpp"
 #include "filtered_qr.hpp"
-#include "secant_rows.hpp"
 
 namespace angio::coupler {
 
@@ -12,7 +11,6 @@ void IqnImvj::begin_step() {
   v_.clear();
   w_.clear();
   d_.clear();
-  jumped_.clear();
   r_prev_.resize(0);
   qt_prev_.resize(0);
   last_ = Correction{};
@@ -41,14 +39,14 @@ Eigen::MatrixXd IqnImvj::times_r_inverse_(const std::vector<Eigen::VectorXd>& co
 
 Eigen::VectorXd IqnImvj::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) {
   const Eigen::VectorXd qt = q + r;
+  const std::vector<Eigen::Index> jumped = take_discontinuous();
   if (k > 0 && r_prev_.size() == r.size()) {
     v_.insert(v_.begin(), r - r_prev_);
     w_.insert(w_.begin(), qt - qt_prev_);
-    drop_rows(v_.front(), jumped_);
-    drop_rows(w_.front(), jumped_);
+    drop_rows(v_.front(), jumped);
+    drop_rows(w_.front(), jumped);
     d_.insert(d_.begin(), w_.front() - apply_prev_(v_.front()));  // J_prev is fixed within the step
   }
-  jumped_.clear();
   r_prev_ = r;
   qt_prev_ = qt;
   std::vector<const Eigen::VectorXd*> vs;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <span>
 #include <stdexcept>
+#include <utility>
 
 #include "angio/contact/normal_field.hpp"
 #include "angio/solid/model.hpp"
@@ -166,7 +167,7 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   last_eval_.clear();
   if (hi - lo == points_.size() && per_surface.size() == searches_.size()) {
     last_eval_ = std::move(per_surface);
-    last_eval_coords_ = coords_;
+    std::swap(last_eval_coords_, coords_);  // no copy: the next evaluation gathers coords_ anew
   }
   timing_.calls++;
   timing_.seconds += MPI_Wtime() - t0;

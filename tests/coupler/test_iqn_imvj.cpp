@@ -46,7 +46,7 @@ TEST(IqnImvj, ComponentMarkedDiscontinuousStaysOutOfTheModel) {
     Eigen::VectorXd q = Eigen::VectorXd::Zero(6);
     plain.begin_step();
     for (int k = 0; k < 6; ++k) {
-      EXPECT_LT((with[k].head(6) - q).norm(), 1e-10 * (1.0 + q.norm())) << "step " << step << ", update " << k;
+      EXPECT_LT((with[k].head(6) - q).norm(), 1e-12 * (1.0 + q.norm())) << "step " << step << ", update " << k;
       if (k >= 1) {
         EXPECT_EQ(with[k][6], 0.3) << "step " << step << ", update " << k;
       }

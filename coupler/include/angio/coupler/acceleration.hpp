@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace angio::coupler {
@@ -27,12 +28,25 @@ class Acceleration {
   // (zero rows): a jump of up to the search radius would otherwise enter the model as the map's
   // response (IQN: the least-squares step moved planes without force by as much; Aitken: its
   // factor). Constant relaxation, without differences, ignores it.
-  virtual void mark_discontinuous(std::vector<Eigen::Index> components) { (void)components; }
+  void mark_discontinuous(std::vector<Eigen::Index> components) { discontinuous_ = std::move(components); }
   // Called when a step converged (e.g. to carry the last relaxation factor to the next step).
   virtual void end_step(bool accepted) = 0;
   // Relaxation factor used in the last update (for logging; 1 for schemes without one).
   virtual double last_factor() const = 0;
   virtual std::string name() const = 0;
+
+ protected:
+  // The components marked since the last update, handed over once: every update() takes them first
+  // (a mark applies to the one difference that update forms, none later).
+  std::vector<Eigen::Index> take_discontinuous() { return std::exchange(discontinuous_, {}); }
+  // Zeroes those rows of a difference.
+  static void drop_rows(Eigen::VectorXd& difference, const std::vector<Eigen::Index>& rows) {
+    for (Eigen::Index i : rows)
+      if (i >= 0 && i < difference.size()) difference[i] = 0.0;
+  }
+
+ private:
+  std::vector<Eigen::Index> discontinuous_;
 };
 
 }  // namespace angio::coupler

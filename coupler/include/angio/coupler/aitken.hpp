@@ -13,7 +13,6 @@ class Aitken : public Acceleration {
   Aitken(double initial, double maximum);
   void begin_step() override;
   Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) override;
-  void mark_discontinuous(std::vector<Eigen::Index> components) override { jumped_ = std::move(components); }
   void end_step(bool accepted) override;
   double last_factor() const override { return omega_; }
   std::string name() const override { return "aitken"; }
@@ -24,7 +23,6 @@ class Aitken : public Acceleration {
   double omega_prev_;        // last factor of the previous accepted step
   double omega_step_start_;  // ω_prev when the current step began (restored on rejection)
   Eigen::VectorXd r_prev_;
-  std::vector<Eigen::Index> jumped_;  // rows left out of the next residual difference
 };
 
 // Constant under-relaxation q_{k+1} = q_k + ω r_k (the baseline that Aitken improves on).

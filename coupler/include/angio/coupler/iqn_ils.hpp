@@ -43,7 +43,6 @@ class IqnIls : public Acceleration {
   void begin_step() override;
   void restart() override;  // also drops the columns of earlier steps
   Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) override;
-  void mark_discontinuous(std::vector<Eigen::Index> components) override { jumped_ = std::move(components); }
   void end_step(bool accepted) override;
   double last_factor() const override { return factor_; }
   std::string name() const override { return "iqn-ils"; }
@@ -60,7 +59,6 @@ class IqnIls : public Acceleration {
   Columns current_;               // of the step in progress
   std::deque<Columns> previous_;  // of earlier accepted steps, newest first
   Eigen::VectorXd r_prev_, qt_prev_;
-  std::vector<Eigen::Index> jumped_;  // rows left out of the next difference column
   double factor_;
   int last_columns_ = 0;
   int restarts_ = 0;

@@ -33,7 +33,6 @@ class IqnImvj : public Acceleration {
   void begin_step() override;
   void restart() override;  // also drops J_prev
   Eigen::VectorXd update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int k) override;
-  void mark_discontinuous(std::vector<Eigen::Index> components) override { jumped_ = std::move(components); }
   void end_step(bool accepted) override;
   double last_factor() const override { return factor_; }
   std::string name() const override { return "iqn-imvj"; }
@@ -53,8 +52,7 @@ class IqnImvj : public Acceleration {
   // this step's columns, newest first: V, W and W − J_prev V (computed once, as a column arrives)
   std::vector<Eigen::VectorXd> v_, w_, d_;
   Eigen::VectorXd r_prev_, qt_prev_;
-  std::vector<Eigen::Index> jumped_;  // rows left out of the next difference column
-  Correction last_;                   // the correction of the last update: J_prev's next term when the step is accepted
+  Correction last_;  // the correction of the last update: J_prev's next term when the step is accepted
   // the last update's filtered QR of V: the kept columns and R (kept x kept)
   std::vector<int> last_kept_;
   Eigen::MatrixXd last_r_;
