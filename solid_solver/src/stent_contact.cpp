@@ -113,6 +113,8 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
   };
   add_surface(opt_.balloon_surface, opt_.balloon_penalty, opt_.balloon_from);
   add_surface(opt_.artery_surface, opt_.artery_penalty, opt_.artery_from);
+  hints_.resize(searches_.size());
+  built_.assign(searches_.size(), 0);
   last_.min_gap = opt_.search_radius;
 }
 
@@ -122,6 +124,10 @@ void PenaltyStentContact::set_points(const participant::SamplePoints& pts) {
   if (pts.w.size() != pts.x.size() || pts.radius.size() != pts.x.size())
     throw std::runtime_error("stent contact: sample points need x, w and radius of equal length");
   last_eval_.clear();
+  if (pts.x.size() != points_.size()) hints_.clear();
+  hints_.resize(searches_.size());
+  for (auto& h : hints_) h.resize(pts.x.size());
+  built_.assign(searches_.size(), 0);
   points_.resize(pts.x.size());
   for (size_t i = 0; i < pts.x.size(); ++i)
     points_[i] = contact::BeamPoint{contact::Vec3(pts.x[i][0], pts.x[i][1], pts.x[i][2]), pts.w[i], pts.radius[i]};
@@ -131,13 +137,14 @@ bool PenaltyStentContact::on_(std::size_t k, const SolidModel& model) const { re
 
 std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const SolidModel& model,
                                                                        std::span<const contact::BeamPoint> points,
-                                                                       bool tangent, bool all) {
+                                                                       std::size_t first, bool tangent, bool all) {
   std::vector<contact::LineContactResult> per_surface;
   if (points.empty() || searches_.empty()) return per_surface;
   gather_coords(model, coords_);
   for (size_t k = 0; k < searches_.size(); ++k) {
     if (!all && !on_(k, model)) continue;
-    searches_[k]->update(coords_, /*rebuild=*/true, /*normal_derivatives=*/tangent);
+    searches_[k]->update(coords_, /*rebuild=*/!built_[k], /*normal_derivatives=*/tangent);
+    built_[k] = 1;
     const contact::SurfaceSearch* one[] = {searches_[k].get()};
     contact::LineContactParams par;
     par.penalty = on_(k, model) ? penalty_[k] : 0.0;
@@ -145,7 +152,8 @@ std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const Sol
     par.averaged_normals = opt_.averaged_normals;
     par.ring_tangent = opt_.ring_tangent;
     par.compute_tangent = tangent;
-    per_surface.push_back(contact::evaluate_line_contact(points, one, par));
+    const std::span<contact::ProjectionHint> hint[] = {std::span(hints_[k]).subspan(first, points.size())};
+    per_surface.push_back(contact::evaluate_line_contact(points, one, par, hint));
   }
   return per_surface;
 }
@@ -157,7 +165,7 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   std::size_t lo, hi;
   slice(points_.size(), model.rank(), model.size(), lo, hi);
   contact::ContactDiagnostics diag;
-  auto per_surface = evaluate_(model, std::span(points_).subspan(lo, hi - lo), K != nullptr, false);
+  auto per_surface = evaluate_(model, std::span(points_).subspan(lo, hi - lo), lo, K != nullptr, false);
   for (auto& res : per_surface) {
     insert(model, res.solid, r, K);
     diag.merge(res.diag);
@@ -199,7 +207,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.total_force = {0.0, 0.0, 0.0};
   // every rank: identical data, no communication; the last assembly's when it saw this configuration
   const bool reuse = !last_eval_.empty() && same_positions(model, last_eval_coords_);
-  const auto per_surface = reuse ? std::move(last_eval_) : evaluate_(model, points_, false, true);
+  const auto per_surface = reuse ? std::move(last_eval_) : evaluate_(model, points_, 0, false, true);
   last_eval_.clear();
   if (per_surface.empty()) return;
   // robin data: one plane per point and surface (K = number of surfaces, point-major), eps = 0 where
@@ -237,7 +245,7 @@ void PenaltyStentContact::gaps(const SolidModel& model, const std::string& surfa
   weight.clear();
   const auto it = std::find(names_.begin(), names_.end(), surface);
   if (it == names_.end() || points_.empty()) return;
-  const auto per_surface = evaluate_(model, points_, false, true);  // every rank: identical data, no communication
+  const auto per_surface = evaluate_(model, points_, 0, false, true);  // every rank: identical data, no communication
   const auto& pcs = per_surface[it - names_.begin()].per_surface[0];
   for (size_t i = 0; i < points_.size(); ++i) {
     gap.push_back(pcs[i].found ? pcs[i].gap : std::numeric_limits<double>::infinity());

@@ -268,3 +268,81 @@ TEST(NormalField, UpdateWithoutDerivativesSameResidualTangentRefused) {
   EXPECT_THROW(evaluate_line_contact(pts, b, par), std::logic_error);
   EXPECT_NO_THROW(evaluate_line_contact(pts, a, par));
 }
+
+// Consistency: a projection hint changes where the search starts, not what it finds. For random points
+// around a perturbed quarter cylinder (quad4 and tri6), the hinted projection equals the unhinted one (face,
+// found, d and s to the projection's Newton tolerance) for a hint at the answer, at a neighbouring face, at a
+// face out of range, with parameters far outside its face, and for no face; with the hint at the answer, the
+// projection restarts there and converges in at most two Newton iterations (from the centre: more).
+TEST(NormalField, HintedProjectionEqualsUnhinted) {
+  for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
+    const test::Mesh m = perturbed_quarter_cylinder(kind, 11);
+    SurfaceSearch S(m.surface, 0.3);
+    S.enable_normal_field();
+    S.update(m.x);
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<double> U(0, 1);
+    const int nf = int(m.surface.faces.size());
+    int found = 0, restarted = 0;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3 x = cyl(0.4 + 0.3 * U(rng), 0.1 + 1.35 * U(rng), 0.05 + 0.5 * U(rng));
+      const SurfaceNormalProjection ref = S.along_normals(x);
+      std::vector<ProjectionHint> hints = {{ref.found ? ref.face : -1, ref.proj.xi},
+                                           {ref.found ? (ref.face + 1) % nf : 0, Vec2(0.1, 0.1)},
+                                           {nf + 3, Vec2::Zero()},
+                                           {(i * 7) % nf, Vec2(5.0, -4.0)},
+                                           {-1, Vec2::Zero()}};
+      for (std::size_t h = 0; h < hints.size(); ++h) {
+        const SurfaceNormalProjection p = S.along_normals(x, 1e-10, &hints[h]);
+        ASSERT_EQ(p.found, ref.found) << "point " << i << " hint " << h;
+        if (!ref.found) continue;
+        EXPECT_EQ(p.face, ref.face) << "point " << i << " hint " << h;
+        EXPECT_NEAR(p.proj.d, ref.proj.d, 1e-12);
+        EXPECT_LT((p.proj.s - ref.proj.s).norm(), 1e-12);
+        if (h == 0) {
+          EXPECT_LE(p.proj.iterations, 2);
+          restarted += ref.proj.iterations > 2;
+        }
+      }
+      found += ref.found;
+    }
+    EXPECT_GT(found, 100);
+    EXPECT_GT(restarted, 50);  // from the centre the same projections take more iterations
+  }
+}
+
+// Consistency: evaluate_line_contact with projection hints gives the residual and tangent of the evaluation
+// without (to the projection's Newton tolerance), fills one hint per found point, and keeps doing so when
+// the surface has moved since the hints were written (the second evaluation starts from stale hints).
+TEST(NormalField, LineContactWithHintsEqualsWithout) {
+  for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
+    test::Mesh m = perturbed_quarter_cylinder(kind, 9);
+    const int n = static_cast<int>(m.x.size());
+    const std::vector<BeamPoint> pts = helix_points();
+    std::vector<ProjectionHint> hints(pts.size());
+    const std::span<ProjectionHint> h[] = {hints};
+    LineContactParams par;
+    par.averaged_normals = true;
+    par.regularization = 0.005;
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass == 1)
+        for (Vec3& x : m.x) x *= 1.01;  // the surface moves toward the points: stale hints
+      SurfaceSearch S(m.surface, 0.3);
+      S.enable_normal_field();
+      S.update(m.x);
+      const SurfaceSearch* s[] = {&S};
+      const LineContactResult plain = evaluate_line_contact(pts, s, par);
+      const LineContactResult hinted = evaluate_line_contact(pts, s, par, h);
+      Eigen::MatrixXd K0, K1;
+      const Eigen::VectorXd r0 = assemble_dense(plain.solid, n, &K0), r1 = assemble_dense(hinted.solid, n, &K1);
+      ASSERT_GT(r0.norm(), 0.0);
+      EXPECT_LT((r1 - r0).norm(), 1e-12 * r0.norm()) << name(kind) << " pass " << pass;
+      EXPECT_LT((K1 - K0).norm(), 1e-12 * K0.norm()) << name(kind) << " pass " << pass;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const PointContact& pc = plain.per_surface[0][i];
+        EXPECT_EQ(hints[i].face, pc.found ? pc.face : -1);
+        if (pc.found) EXPECT_LT((hints[i].xi - pc.proj.xi).norm(), 1e-12);
+      }
+    }
+  }
+}

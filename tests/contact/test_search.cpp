@@ -68,3 +68,45 @@ TEST(Search, FreeEdgesAndRim) {
   ASSERT_TRUE(q.found);
   EXPECT_NEAR(q.proj.d, -0.1, 1e-14);
 }
+
+// Compares against: brute force — the query with the boxes shrunk by s returns exactly the faces whose
+// (inflated) box shrunk by s on every side contains the point, after a rebuild and after a refit.
+TEST(Search, ShrunkQueryMatchesBruteForce) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  Mesh m = cylinder(FaceKind::Quad4, 0.5, 3.0, 24, 20);
+  SurfaceSearch S(m.surface, 0.3);
+  S.update(m.x);
+  std::vector<Aabb> boxes(m.surface.faces.size());
+  for (std::size_t f = 0; f < boxes.size(); ++f) boxes[f] = S.face_box(int(f));
+  AabbTree tree;
+  tree.build(boxes);
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {  // move the boxes (a refit keeps the topology of the first build)
+      for (Aabb& b : boxes) {
+        const Vec3 t = 0.05 * Vec3(U(rng), U(rng), U(rng));
+        b.lo += t;
+        b.hi += t;
+      }
+      tree.refit(boxes);
+    }
+    int nonempty = 0;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3 x = cyl(0.5 + 0.3 * U(rng), M_PI * U(rng), 1.5 + 1.6 * U(rng));
+      for (double s : {0.0, 0.1, 0.25, 0.29}) {
+        std::vector<int> got;
+        tree.query(x, s, got);
+        std::sort(got.begin(), got.end());
+        std::vector<int> ref;
+        for (int f = 0; f < int(boxes.size()); ++f) {
+          Aabb b = boxes[f];
+          b.inflate(-s);
+          if (b.contains(x)) ref.push_back(f);
+        }
+        EXPECT_EQ(got, ref) << "pass " << pass << " point " << i << " shrink " << s;
+        nonempty += !ref.empty() && s > 0.2;
+      }
+    }
+    EXPECT_GT(nonempty, 20);  // the shrunk queries are not all empty
+  }
+}

@@ -130,7 +130,8 @@ void chain_normals(const Face& face, const SurfaceSearch& S, bool ring, NodalCon
 }  // namespace
 
 LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
-                                        std::span<const SurfaceSearch* const> surfaces, const LineContactParams& par) {
+                                        std::span<const SurfaceSearch* const> surfaces, const LineContactParams& par,
+                                        std::span<const std::span<ProjectionHint>> hints) {
   LineContactResult res;
   res.q.assign(points.size(), Vec3::Zero());
   res.per_surface.resize(surfaces.size());
@@ -142,14 +143,19 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
           "evaluate_line_contact: a tangent along the normal field needs SurfaceSearch::update() "
           "with the normals' derivatives");
     auto& pcs = res.per_surface[k];
+    const std::span<ProjectionHint> hint =
+        k < hints.size() && hints[k].size() == points.size() ? hints[k] : std::span<ProjectionHint>{};
     pcs.assign(points.size(), PointContact{});
+    NodalContribution nc;  // reused: its buffers are allocated again only after an active point took them
     for (std::size_t i = 0; i < points.size(); ++i) {
       const BeamPoint& bp = points[i];
       PointContact& pc = pcs[i];
-      NodalContribution nc;
+      nc.nodes.clear();
       Eigen::MatrixXd* K = par.compute_tangent ? &nc.K : nullptr;
       if (par.averaged_normals) {
-        const SurfaceNormalProjection sp = S.along_normals(bp.x, par.projection.inside_tol);
+        ProjectionHint* h = hint.empty() ? nullptr : &hint[i];
+        const SurfaceNormalProjection sp = S.along_normals(bp.x, par.projection.inside_tol, h);
+        if (h) *h = sp.found ? ProjectionHint{sp.face, sp.proj.xi} : ProjectionHint{};
         if (!sp.found) continue;
         pc.face = sp.face;
         line_point_kernel_averaged(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), S.face_normals(sp.face),

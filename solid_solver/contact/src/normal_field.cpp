@@ -75,9 +75,9 @@ void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_n
 }
 
 NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const FaceX& Nn, const Vec3& x,
-                                            double inside_tol, int max_iter) {
+                                            double inside_tol, int max_iter, const Vec2* start) {
   NormalFieldProjection p;
-  Vec2 xi = center_xi(k);
+  Vec2 xi = start ? *start : center_xi(k);
   ShapeN N;
   ShapeD dN;
   shape(k, xi, N, &dN);

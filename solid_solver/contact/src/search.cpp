@@ -61,11 +61,15 @@ void AabbTree::refit(const std::vector<Aabb>& boxes) {
   }
 }
 
-// A point query is a box query with a degenerate box (overlaps == contains for lo == hi == p).
-void AabbTree::query(const Vec3& p, std::vector<int>& out) const {
+void AabbTree::query(const Vec3& p, std::vector<int>& out) const { query(p, 0.0, out); }
+
+// A box query with the inverted box [p + shrink, p - shrink]: it overlaps a box B iff B.lo + shrink <= p <=
+// B.hi - shrink, i.e. iff B shrunk by `shrink` contains p (shrink 0: a degenerate box, overlaps == contains).
+// A node's box shrunk contains every child's box shrunk, so the descent stays exact.
+void AabbTree::query(const Vec3& p, double shrink, std::vector<int>& out) const {
   Aabb b;
-  b.lo = p;
-  b.hi = p;
+  b.lo = p.array() + shrink;
+  b.hi = p.array() - shrink;
   query(b, out);
 }
 
@@ -148,27 +152,40 @@ double box_dist2(const Aabb& b, const Vec3& p) {
   return d.squaredNorm();
 }
 
+// A face already projected before the visit (SurfaceSearch::along_normals' hint).
+template <class Proj>
+struct Visited {
+  int face = -1;
+  double d = std::numeric_limits<double>::infinity();
+  Proj proj{};
+};
+
 // Best projection over `faces`: project(f, proj) projects onto face f and returns the distance |p - s| (infinity to
 // reject the face). Faces are visited by increasing distance from p to their (uninflated) boxes, and the visit stops
-// once that lower bound exceeds the best distance so far (exact pruning: s lies in its face's box). Ties: lowest
-// face index. Result (SurfaceProjection or SurfaceNormalProjection): found if the best distance is within radius.
+// once that lower bound exceeds the best distance so far (exact pruning: s lies in its face's box). `seed` (a face
+// projected already, or none) is the best so far from the start and is not visited again. Ties: lowest face
+// index, whatever the order of the visit. Result (SurfaceProjection or SurfaceNormalProjection): found if the best
+// distance is within radius.
 template <class Result, class Project>
 Result nearest_first(const std::vector<Aabb>& boxes, double inflation, const std::vector<int>& faces, const Vec3& p,
-                     double radius, Project project) {
+                     double radius, Project project, const Visited<decltype(Result::proj)>& seed = {}) {
   using Proj = decltype(Result::proj);
+  int best = seed.d < std::numeric_limits<double>::infinity() ? seed.face : -1;
+  Proj best_proj = seed.proj, pr{};
+  double dmin = seed.d;
+  auto beyond = [&](double lb2) { return std::sqrt(lb2) > dmin * (1.0 + 1e-12) + 1e-300; };
   thread_local std::vector<std::pair<double, int>> order;
   order.clear();
   for (int f : faces) {
+    if (f == seed.face) continue;
     Aabb b = boxes[f];
     b.inflate(-inflation);
-    order.emplace_back(box_dist2(b, p), f);
+    const double lb2 = box_dist2(b, p);
+    if (!beyond(lb2)) order.emplace_back(lb2, f);
   }
   std::sort(order.begin(), order.end());
-  int best = -1;
-  Proj best_proj{}, pr{};
-  double dmin = std::numeric_limits<double>::infinity();
   for (const auto& [lb2, f] : order) {
-    if (std::sqrt(lb2) > dmin * (1.0 + 1e-12) + 1e-300) break;
+    if (beyond(lb2)) break;
     const double d = project(f, pr);
     if (d < dmin || (d == dmin && d < std::numeric_limits<double>::infinity() && f < best)) {
       dmin = d;
@@ -208,16 +225,41 @@ SurfaceProjection SurfaceSearch::closest(const Vec3& p, const ProjectionOptions&
   return closest_over(*surface_, X_, boxes_, radius_, cand, p, radius_, opt, reject_free_ ? &free_ : nullptr);
 }
 
-SurfaceNormalProjection SurfaceSearch::along_normals(const Vec3& p, double inside_tol) const {
+SurfaceNormalProjection SurfaceSearch::along_normals(const Vec3& p, double inside_tol,
+                                                     const ProjectionHint* hint) const {
   if (!normal_field_) throw std::logic_error("SurfaceSearch: along_normals() needs enable_normal_field()");
-  thread_local std::vector<int> cand;
-  candidates(p, cand);
+  if (!ready_) throw std::logic_error("SurfaceSearch: update() not called");
+  auto project = [&](int f, const Vec2* start) {
+    return project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol, 30, start);
+  };
   // |d| = |p - s|: the pruning of the closest point applies unchanged
+  auto distance = [](const NormalFieldProjection& pr) {
+    return pr.valid ? std::abs(pr.d) : std::numeric_limits<double>::infinity();
+  };
+  // The hint's face first, if it is a candidate (its inflated box holds p): its distance d bounds the
+  // rest, so only faces whose box lies within d of p are gathered (a tree query with the boxes shrunk by
+  // radius - d; a little wider, for the rounding of the boxes), not every face within the radius.
+  Visited<NormalFieldProjection> seed;
+  double shrink = 0.0;
+  if (hint && hint->face >= 0 && hint->face < int(boxes_.size()) && boxes_[hint->face].contains(p)) {
+    seed.face = hint->face;
+    seed.proj = project(hint->face, &hint->xi);
+    seed.d = distance(seed.proj);
+    if (seed.d <= radius_)
+      shrink = std::max(0.0, radius_ - seed.d * (1.0 + 1e-9) - 1e-9 * radius_);
+    else if (!seed.proj.valid)
+      seed = {};  // no root in the face from there: the face is projected again from its centre below
+  }
+  thread_local std::vector<int> cand;
+  cand.clear();
+  tree_.query(p, shrink, cand);  // unsorted: nearest_first orders them itself and breaks ties by face index
   return nearest_first<SurfaceNormalProjection>(
-      boxes_, radius_, cand, p, radius_, [&](int f, NormalFieldProjection& pr) {
-        pr = project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol);
-        return pr.valid ? std::abs(pr.d) : std::numeric_limits<double>::infinity();
-      });
+      boxes_, radius_, cand, p, radius_,
+      [&](int f, NormalFieldProjection& pr) {
+        pr = project(f, nullptr);
+        return distance(pr);
+      },
+      seed);
 }
 
 SurfaceProjection SurfaceSearch::closest_brute_force(const Vec3& p, const ProjectionOptions& opt) const {

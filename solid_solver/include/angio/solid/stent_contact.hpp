@@ -96,8 +96,9 @@ class PenaltyStentContact : public StentContact {
   // Updates the searches to the current configuration and evaluates `points` against each surface (own penalty).
   // all = false: the surfaces that are off at the model's time are left out (add); true: they are
   // evaluated with penalty 0 so that the results stay indexed by surface (reply, gaps).
+  // first: the index of points[0] in points_ (for the projection hints).
   std::vector<contact::LineContactResult> evaluate_(const SolidModel& model, std::span<const contact::BeamPoint> points,
-                                                    bool tangent, bool all);
+                                                    std::size_t first, bool tangent, bool all);
 
   Options opt_;
   std::vector<std::string> names_;
@@ -107,6 +108,12 @@ class PenaltyStentContact : public StentContact {
   std::vector<std::unique_ptr<contact::Surface>> surfaces_;
   std::vector<std::unique_ptr<contact::SurfaceSearch>> searches_;
   std::vector<contact::BeamPoint> points_;
+  // Per surface and point: where the point projected at the last evaluation (a start for the next).
+  // The points move little between the evaluations of a solve and between coupling iterations.
+  std::vector<std::vector<contact::ProjectionHint>> hints_;
+  // Per surface: its search tree was built for the current points' solve; later evaluations refit it
+  // (same result; the tree's shape only decides how fast it answers).
+  std::vector<char> built_;
   std::vector<contact::Vec3> coords_;
   // The last add()'s evaluation when it covered every point and surface (one rank, every pair on), and
   // the coordinates it saw: fill_reply() at the same configuration (a converged Newton's last residual)

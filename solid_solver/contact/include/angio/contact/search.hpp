@@ -18,6 +18,8 @@ class AabbTree {
   void refit(const std::vector<Aabb>& boxes);
   // Items whose box contains p / overlaps b (appended to out, unsorted).
   void query(const Vec3& p, std::vector<int>& out) const;
+  // Items whose box, shrunk by `shrink` (>= 0) on every side, contains p.
+  void query(const Vec3& p, double shrink, std::vector<int>& out) const;
   void query(const Aabb& b, std::vector<int>& out) const;
   std::size_t size() const { return items_.size(); }
 
@@ -47,6 +49,13 @@ struct SurfaceNormalProjection {
   NormalFieldProjection proj;
 };
 
+// Where a point projected at an earlier evaluation (its face and the face parameters there): a start for
+// the next projection of the same point. face = -1: none.
+struct ProjectionHint {
+  int face = -1;
+  Vec2 xi = Vec2::Zero();
+};
+
 class SurfaceSearch {
  public:
   // radius: faces farther than `radius` from a query point are ignored (mm).
@@ -66,7 +75,11 @@ class SurfaceSearch {
   SurfaceProjection closest(const Vec3& p, const ProjectionOptions& opt = {}) const;
   // Projection along the averaged nodal normal field (enable_normal_field()) over the candidate faces: the valid one
   // with the smallest |d| (ties: lowest face index); found only if |d| <= radius.
-  SurfaceNormalProjection along_normals(const Vec3& p, double inside_tol = 1e-10) const;
+  // A hint's face, if it is a candidate, is projected first and from the hint's parameters: the same result
+  // (to the projection's Newton tolerance) with fewer projections and iterations when the point and the
+  // surface moved little since.
+  SurfaceNormalProjection along_normals(const Vec3& p, double inside_tol = 1e-10,
+                                        const ProjectionHint* hint = nullptr) const;
   // Same over all faces (reference for tests; ignores the tree but applies the radius).
   SurfaceProjection closest_brute_force(const Vec3& p, const ProjectionOptions& opt = {}) const;
 
