@@ -113,8 +113,6 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
   };
   add_surface(opt_.balloon_surface, opt_.balloon_penalty, opt_.balloon_from);
   add_surface(opt_.artery_surface, opt_.artery_penalty, opt_.artery_from);
-  hints_.resize(searches_.size());
-  built_.assign(searches_.size(), 0);
   last_.min_gap = opt_.search_radius;
 }
 
@@ -124,9 +122,9 @@ void PenaltyStentContact::set_points(const participant::SamplePoints& pts) {
   if (pts.w.size() != pts.x.size() || pts.radius.size() != pts.x.size())
     throw std::runtime_error("stent contact: sample points need x, w and radius of equal length");
   last_eval_.clear();
-  if (pts.x.size() != points_.size()) hints_.clear();
-  hints_.resize(searches_.size());
-  for (auto& h : hints_) h.resize(pts.x.size());
+  // hints of the same points stay (they moved little); a new set of points starts without
+  if (hints_.empty() || pts.x.size() != points_.size())
+    hints_.assign(searches_.size(), std::vector<contact::ProjectionHint>(pts.x.size()));
   built_.assign(searches_.size(), 0);
   points_.resize(pts.x.size());
   for (size_t i = 0; i < pts.x.size(); ++i)

@@ -75,7 +75,7 @@ void nodal_normals(const Surface& s, std::span<const FaceX> X, std::size_t num_n
 }
 
 NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const FaceX& Nn, const Vec3& x,
-                                            double inside_tol, int max_iter, const Vec2* start) {
+                                            double inside_tol, const Vec2* start, int max_iter) {
   NormalFieldProjection p;
   Vec2 xi = start ? *start : center_xi(k);
   ShapeN N;

@@ -230,7 +230,7 @@ SurfaceNormalProjection SurfaceSearch::along_normals(const Vec3& p, double insid
   if (!normal_field_) throw std::logic_error("SurfaceSearch: along_normals() needs enable_normal_field()");
   if (!ready_) throw std::logic_error("SurfaceSearch: update() not called");
   auto project = [&](int f, const Vec2* start) {
-    return project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol, 30, start);
+    return project_along_normals(surface_->faces[f].kind, X_[f], normals_.face[f], p, inside_tol, start);
   };
   // |d| = |p - s|: the pruning of the closest point applies unchanged
   auto distance = [](const NormalFieldProjection& pr) {

@@ -60,7 +60,7 @@ struct NormalFieldProjection {
 // Solves x_s(xi) + alpha m(xi) = x on one face by Newton from the face centre, or from `start` (e.g.
 // where the same point projected at an earlier evaluation: fewer iterations, the same root).
 NormalFieldProjection project_along_normals(FaceKind k, const FaceX& X, const FaceX& Nn, const Vec3& x,
-                                            double inside_tol = 1e-10, int max_iter = 30, const Vec2* start = nullptr);
+                                            double inside_tol = 1e-10, const Vec2* start = nullptr, int max_iter = 30);
 
 // First derivatives of the projection with respect to u = [x (3), X_0 (3), ..., X_{nn-1} (3),
 // n_0 (3), ..., n_{nn-1} (3)]: the point, the face's nodes and its nodal normals taken as independent
