@@ -73,6 +73,14 @@ int main(int argc, char** argv) {
         PetscFinalize();
         return 2;
       }
+      if (scene.options.newton.reuse_preconditioner > 0 && pc.ksp_type == KSPPREONLY) {
+        // preonly would take the old preconditioner alone for a solve of the current tangent
+        if (rank == 0)
+          LOG_ERROR(cli.get("scene") << ": solid.newton.reuse_preconditioner: expected 0 with -ksp_type preonly, or a "
+                                        "Krylov solver in solid.petsc_options (-ksp_type gmres)");
+        PetscFinalize();
+        return 2;
+      }
       if (rank == 0 && !pc.unused.empty()) {
         std::string list;
         for (const auto& u : pc.unused) list += " " + u;

@@ -85,6 +85,9 @@ PetscOptionsCheck check_petsc_options(const std::string& options, const std::vec
     }
     PetscCall(KSPSetUp(ksp));
     PetscCall(KSPSolve(ksp, b, x));
+    KSPType type;
+    PetscCall(KSPGetType(ksp, &type));
+    out.ksp_type = type;
     return PetscErrorCode(0);
   };
   const PetscErrorCode err = run();

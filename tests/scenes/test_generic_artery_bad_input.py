@@ -83,6 +83,12 @@ CASES = [
         "solid.petsc_options",
     ),
     ("continuation 1", lambda s: s["solid"]["newton"].update(continuation=1), "solid.newton.continuation"),
+    # the old factorization alone (preonly) would be taken for a solve of the current tangent
+    (
+        "reuse_preconditioner with preonly",
+        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_preconditioner=10),
+        "solid.newton.reuse_preconditioner",
+    ),
     # the virtual insertion tool and the contact switch-on time
     (
         "insertion axis of one point",
