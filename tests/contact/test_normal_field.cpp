@@ -341,8 +341,15 @@ TEST(NormalField, LineContactWithHintsEqualsWithout) {
       for (std::size_t i = 0; i < pts.size(); ++i) {
         const PointContact& pc = plain.per_surface[0][i];
         EXPECT_EQ(hints[i].face, pc.found ? pc.face : -1);
-        if (pc.found) EXPECT_LT((hints[i].xi - pc.proj.xi).norm(), 1e-12);
+        if (pc.found) {
+          EXPECT_LT((hints[i].xi - pc.proj.xi).norm(), 1e-12);
+        }
       }
+      // hints of another shape are refused, not ignored
+      const std::span<ProjectionHint> short_hints[] = {std::span(hints).first(pts.size() - 1)};
+      const std::span<ProjectionHint> two[] = {hints, hints};
+      EXPECT_THROW(evaluate_line_contact(pts, s, par, short_hints), std::invalid_argument);
+      EXPECT_THROW(evaluate_line_contact(pts, s, par, two), std::invalid_argument);
     }
   }
 }

@@ -6,7 +6,9 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <iomanip>
 #include <random>
+#include <sstream>
 
 #include "angio/scene/node.hpp"
 #include "angio/solid/contact_scene.hpp"
@@ -449,8 +451,10 @@ BAResult balloon_artery_run(MPI_Comm comm, const std::string& petsc_options = ""
     const auto rep = model.solve();
     if (!rep.converged) {
       res.converged = false;
-      res.failure = "step " + std::to_string(step) + ": " + rep.message + "; |r| history:";
-      for (double r : rep.residual_history) res.failure += " " + std::to_string(r);
+      std::ostringstream m;  // scientific: the residuals span 1e-2 .. 1e-16
+      m << "step " << step << ": " << rep.message << "; |r| history:" << std::scientific << std::setprecision(3);
+      for (double r : rep.residual_history) m << " " << r;
+      res.failure = m.str();
       return res;
     }
     model.commit();

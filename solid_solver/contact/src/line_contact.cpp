@@ -132,6 +132,12 @@ void chain_normals(const Face& face, const SurfaceSearch& S, bool ring, NodalCon
 LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
                                         std::span<const SurfaceSearch* const> surfaces, const LineContactParams& par,
                                         std::span<const std::span<ProjectionHint>> hints) {
+  // hints of the wrong shape would be ignored silently (and the search pay its full price)
+  if (!hints.empty() && hints.size() != surfaces.size())
+    throw std::invalid_argument("evaluate_line_contact: hints need one span per surface");
+  for (const auto& h : hints)
+    if (!h.empty() && h.size() != points.size())
+      throw std::invalid_argument("evaluate_line_contact: hints need one per point (or none for a surface)");
   LineContactResult res;
   res.q.assign(points.size(), Vec3::Zero());
   res.per_surface.resize(surfaces.size());
@@ -143,8 +149,7 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
           "evaluate_line_contact: a tangent along the normal field needs SurfaceSearch::update() "
           "with the normals' derivatives");
     auto& pcs = res.per_surface[k];
-    const std::span<ProjectionHint> hint =
-        k < hints.size() && hints[k].size() == points.size() ? hints[k] : std::span<ProjectionHint>{};
+    const std::span<ProjectionHint> hint = hints.empty() ? std::span<ProjectionHint>{} : hints[k];
     pcs.assign(points.size(), PointContact{});
     NodalContribution nc;  // reused: its buffers are allocated again only after an active point took them
     for (std::size_t i = 0; i < points.size(); ++i) {

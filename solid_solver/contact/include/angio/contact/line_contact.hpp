@@ -125,7 +125,8 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
 // Evaluate all points against all surfaces (searches must be update()d with the current coordinates).
 // The contributions of different surfaces add up (a point may touch balloon and artery at the same time).
 // hints (averaged normals; optional): per surface, one per point, where each point projected at the last
-// evaluation (SurfaceSearch::along_normals); read as starts and overwritten with this evaluation's.
+// evaluation (SurfaceSearch::along_normals); read as starts and overwritten with this evaluation's. An
+// empty span for a surface: no hints there. Other shapes throw std::invalid_argument.
 LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
                                         std::span<const SurfaceSearch* const> surfaces, const LineContactParams& par,
                                         std::span<const std::span<ProjectionHint>> hints = {});
