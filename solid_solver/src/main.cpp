@@ -81,6 +81,13 @@ int main(int argc, char** argv) {
         PetscFinalize();
         return 2;
       }
+      if (!scene.options.newton.reuse_parts.empty() && !pc.fieldsplit) {
+        if (rank == 0)
+          LOG_ERROR(cli.get("scene") << ": solid.newton.reuse_parts: expected -pc_type fieldsplit in "
+                                        "solid.petsc_options (one split per part), or no reuse_parts");
+        PetscFinalize();
+        return 2;
+      }
       if (rank == 0 && !pc.unused.empty()) {
         std::string list;
         for (const auto& u : pc.unused) list += " " + u;

@@ -333,6 +333,26 @@ void SolidModel::setup_petsc_() {
   PetscBool split = PETSC_FALSE;
   ANGIO_PETSC(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &split));
   if (split) set_part_splits_(pc);
+  const std::vector<std::string> parts = part_names(mesh_);
+  for (const auto& name : opt_.newton.reuse_parts) {
+    const auto at = std::find(parts.begin(), parts.end(), name);
+    if (!split || at == parts.end() || opt_.newton.reuse_preconditioner <= 0)
+      throw std::invalid_argument("newton.reuse_parts: '" + name +
+                                  "' needs -pc_type fieldsplit, a part of the mesh and reuse_preconditioner > 0");
+    kept_splits_.push_back(int(at - parts.begin()));
+  }
+}
+
+void SolidModel::keep_splits_(bool keep) {
+  // the flag is read by each split's own setup inside the next KSPSolve (the splits exist after the first)
+  if (!splits_ready_) return;
+  PC pc;
+  ANGIO_PETSC(KSPGetPC(ksp_, &pc));
+  PetscInt n = 0;
+  KSP* sub = nullptr;
+  ANGIO_PETSC(PCFieldSplitGetSubKSP(pc, &n, &sub));
+  for (int k : kept_splits_) ANGIO_PETSC(KSPSetReusePreconditioner(sub[k], keep ? PETSC_TRUE : PETSC_FALSE));
+  ANGIO_PETSC(PetscFree(sub));
 }
 
 std::vector<std::string> SolidModel::unused_petsc_options() const {
@@ -613,12 +633,13 @@ void SolidModel::lift_prescribed_increment_(SolveReport& rep) {
   ANGIO_PETSC(MatZeroRowsColumns(K_, PetscInt(dirichlet_rows_.size()), dirichlet_rows_.data(), 1.0, du_, r_));
   KSPConvergedReason reason;
   ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));  // the tangent of the lifting itself
+  keep_splits_(false);
   {
     OptionsScope scope(options_);
     ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
   }
   ++rep.factorizations;
-  pc_current_ = true;
+  pc_current_ = kept_current_ = splits_ready_ = true;
   ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
   if (reason > 0 || reason == KSP_DIVERGED_ITS) {
     std::vector<double> du_full;
@@ -649,13 +670,17 @@ SolidModel::NewtonLinearSolve SolidModel::newton_linear_solve_(SolveReport& rep,
   KSPConvergedReason reason;
   PetscInt lits;
   const int lag = no.reuse_preconditioner;
-  bool reuse = modified ? !fresh : lag > 0 && pc_current_;
+  // reuse_parts: the whole preconditioner is set up with every tangent but for the kept splits
+  const bool by_parts = !kept_splits_.empty();
+  bool reuse = modified ? !fresh : lag > 0 && (by_parts ? kept_current_ : pc_current_);
   auto linear_solve = [&] {
-    ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse ? PETSC_TRUE : PETSC_FALSE));
+    ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, reuse && !by_parts ? PETSC_TRUE : PETSC_FALSE));
+    if (by_parts) keep_splits_(reuse);
     {
       OptionsScope scope(options_);
       ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
     }
+    splits_ready_ = true;
     ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
     ANGIO_PETSC(KSPGetIterationNumber(ksp_, &lits));
     rep.linear_iterations += int(lits);
@@ -676,6 +701,7 @@ SolidModel::NewtonLinearSolve SolidModel::newton_linear_solve_(SolveReport& rep,
       linear_solve();
     }
     pc_current_ = !(reuse && lits > lag);  // slow with the old one: the next solve refactorizes
+    kept_current_ = pc_current_;
   }
   out.iterations = lits;
   rep.linear_seconds += MPI_Wtime() - t0;
@@ -696,12 +722,12 @@ SolidModel::NewtonLinearSolve SolidModel::newton_linear_solve_(SolveReport& rep,
 SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const std::vector<double>& du_full, double res,
                                                       bool stale, int it) {
   const auto& no = opt_.newton;
-  const bool modified = no.modified;
   u_base_ = u_;  // the iterate the step starts from (a member: no allocation per Newton iteration)
   const std::vector<double>& u_base = u_base_;
-  // line search (backtracking on ||r||); exact Newton assembles the tangent with the trial
-  // residual so that an accepted full step costs no extra assembly. alpha ends as the last
-  // trial's step. A step of an old factorization (modified Newton) gets no line search: if it
+  // line search (backtracking on ||r||) on residuals alone: a tangent assembly costs about seven
+  // residual ones (element tangents and matrix insertion), so the exact Newton's tangent is assembled
+  // once at the accepted iterate, and not at all where that iterate has converged (solve()). alpha
+  // ends as the last trial's step. A step of an old factorization (modified Newton) gets no line search: if it
   // does not reduce ||r||, it is undone and the current tangent factorized instead.
   double alpha = 1.0, best_alpha = 1.0, best_merit = std::numeric_limits<double>::infinity();
   double new_res = 0.0;
@@ -713,7 +739,7 @@ SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const st
   const bool energy = s0 < 0.0;
   for (int ls = 0;; ++ls, alpha *= 0.5) {
     for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
-    const bool aok = assemble_iterate_(rep, !modified);
+    const bool aok = assemble_iterate_(rep, false);
     new_res = aok ? norm2(r_) : std::numeric_limits<double>::infinity();
     if (!std::isfinite(new_res)) new_res = std::numeric_limits<double>::infinity();
     const double merit = !std::isfinite(new_res) ? new_res : energy ? std::abs(slope_along_(du_full)) : new_res;
@@ -738,10 +764,10 @@ SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const st
                     invalid_element() + ")";
       return out;
     }
-    if (best_alpha != alpha) {  // r_ (and K_) hold the last trial: back to the best one
+    if (best_alpha != alpha) {  // r_ holds the last trial: back to the best one
       alpha = best_alpha;
       for (size_t i = 0; i < u_.size(); ++i) u_[i] = u_base[i] + alpha * du_full[i];
-      assemble_iterate_(rep, !modified);
+      assemble_iterate_(rep, false);
       new_res = norm2(r_);
     }
   }
@@ -808,14 +834,18 @@ SolveReport SolidModel::solve(double loose_atol) {
   // fresh: K_ holds the tangent at the current iterate (to be factorized); otherwise the modified
   // Newton iterates with the factorization held by the KSP.
   bool fresh = !modified || !pc_current_;
-  if (!assemble_iterate_(rep, fresh))
-    return fail("invalid configuration at the start of the solve (non-positive Jacobian or NaN; " + invalid_element() +
-                ")");
+  auto invalid_start = [&] {
+    return "invalid configuration at the start of the solve (non-positive Jacobian or NaN; " + invalid_element() + ")";
+  };
+  // the residual first: a solve that starts converged (a held load, a coupling iteration whose
+  // interface did not move) needs no tangent
+  if (!assemble_iterate_(rep, false)) return fail(invalid_start());
   double res = norm2(r_);
   if (!std::isfinite(res)) return fail("residual is NaN/Inf at the start of the solve");
   const double res0 = res;
   if (no.verbose && rank_ == 0) std::printf("    newton  0  |r| = %.3e\n", res0);
   auto converged = [&](double r, int it) { return r <= atol || (it > 0 && r <= no.rtol * res0); };
+  if (fresh && !converged(res, 0) && !assemble_iterate_(rep, true)) return fail(invalid_start());
   rep.residual_history.push_back(res);
   std::vector<double> du_full;
   // Modified Newton: the old factorization failed or diverged at this iterate; the next iteration
@@ -854,12 +884,10 @@ SolveReport SolidModel::solve(double loose_atol) {
       continue;
     }
     if (!step.failure.empty()) return fail(step.failure);
-    if (modified) {
-      // keep the factorization while it contracts fast enough; otherwise the tangent here, for the
-      // next iteration (the residual is assembled again with it)
-      fresh = !(step.residual <= no.max_contraction * res) && !converged(step.residual, it + 1);
-      if (fresh && !assemble_iterate_(rep, true)) return fail(invalid_at(it));
-    }
+    // the tangent here for the next iteration (the residual is assembled again with it): exact Newton
+    // unless converged; modified Newton where the old factorization contracts too slowly
+    fresh = !modified || !(step.residual <= no.max_contraction * res);
+    if (fresh && !converged(step.residual, it + 1) && !assemble_iterate_(rep, true)) return fail(invalid_at(it));
     res = step.residual;
     rep.residual_history.push_back(res);
     if (no.verbose) log_newton_iteration_(it, res, step.alpha, linear.iterations, stale);
@@ -939,7 +967,7 @@ void SolidModel::commit() {
 }
 void SolidModel::rollback() {
   u_ = u_committed_;
-  pc_current_ = false;  // a rejected step restarts from a fresh factorization
+  pc_current_ = kept_current_ = false;  // a rejected step restarts from a fresh factorization
 }
 
 bool SolidModel::predict() {

@@ -88,6 +88,7 @@ PetscOptionsCheck check_petsc_options(const std::string& options, const std::vec
     KSPType type;
     PetscCall(KSPGetType(ksp, &type));
     out.ksp_type = type;
+    out.fieldsplit = split;
     return PetscErrorCode(0);
   };
   const PetscErrorCode err = run();

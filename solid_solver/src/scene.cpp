@@ -459,18 +459,28 @@ void read_solver_options(const Node& s, SolidScene& sc) {
     no.energy_line_search = n->get<std::string>("line_search_merit") == "energy";
     no.verbose = n->get<bool>("verbose");
     no.damping = n->get<double>("damping");
+    auto parts = [&](const Node& list) {  // a non-empty list of this scene's parts
+      if (!list.is_sequence() || list.size() == 0) list.fail("a list of parts out of balloon, artery");
+      std::vector<std::string> out;
+      for (size_t i = 0; i < list.size(); ++i) {
+        const std::string part = list.at(i).as_string();
+        if (!((part == "balloon" && sc.has_balloon) || (part == "artery" && sc.has_artery)))
+          list.at(i).fail(std::string("a part of this scene (") + (sc.has_balloon ? "balloon" : "") +
+                          (sc.has_balloon && sc.has_artery ? ", " : "") + (sc.has_artery ? "artery" : "") + ")");
+        out.push_back(part);
+      }
+      return out;
+    };
     if (auto dp = n->optional("damping_parts")) {
       if (!(no.damping > 0)) dp->fail("no damping_parts without damping > 0");
-      if (!dp->is_sequence() || dp->size() == 0) dp->fail("a list of parts out of balloon, artery");
-      for (size_t i = 0; i < dp->size(); ++i) {
-        const std::string part = dp->at(i).as_string();
-        if (!((part == "balloon" && sc.has_balloon) || (part == "artery" && sc.has_artery)))
-          dp->at(i).fail(std::string("a part of this scene (") + (sc.has_balloon ? "balloon" : "") +
-                         (sc.has_balloon && sc.has_artery ? ", " : "") + (sc.has_artery ? "artery" : "") + ")");
-        no.damping_parts.push_back(part);
-      }
+      no.damping_parts = parts(*dp);
     }
     no.reuse_preconditioner = n->get<int>("reuse_preconditioner");
+    if (auto rp = n->optional("reuse_parts")) {
+      if (no.reuse_preconditioner <= 0)
+        rp->fail("solid.newton.reuse_preconditioner > 0 (the Krylov iterations that renew the kept splits)");
+      no.reuse_parts = parts(*rp);
+    }
     no.modified = n->get<std::string>("tangent") == "modified";
     no.max_contraction = n->get<double>("max_contraction");
     no.continuation = n->get<int>("continuation");

@@ -86,6 +86,13 @@ struct NewtonOptions {
   // of that. The Newton iteration itself keeps the exact tangent (quadratic convergence as long as
   // the Krylov tolerance is tight). 0 = refactorize at every iteration.
   int reuse_preconditioner = scene::keys::defaults::solid_newton_reuse_preconditioner;
+  // With -pc_type fieldsplit (one split per part) and reuse_preconditioner > 0: the parts whose
+  // split keeps its preconditioner as above; the other splits are set up again with every tangent.
+  // A balloon unfolding under pressure changes its tangent at every iteration while the artery's
+  // changes slowly: a fresh factorization of the small balloon split and an old one of the large
+  // artery split (kept also when contact grows the matrix's pattern: it still preconditions the new
+  // one). Empty: the whole preconditioner is kept or renewed together.
+  std::vector<std::string> reuse_parts;
   // Modified Newton (tangent: modified): the factorization of an earlier tangent is kept across Newton
   // iterations, solves (coupling iterations) and steps as long as each iteration reduces ||r|| by at
   // least the factor max_contraction; iterations with it assemble the residual only (no element
@@ -261,6 +268,7 @@ class SolidModel {
   // centroid of that configuration, for failure messages (same on every rank).
   std::string invalid_element() const;
   Mat matrix() const { return K_; }
+  KSP linear_solver() const { return ksp_; }  // for inspection (its splits, its factorizations)
   int pattern_rebuilds() const { return pattern_rebuilds_; }  // of the matrix by contact pairs new to its pattern
   // The options of ModelOptions::petsc_options no solver object has asked for so far (misspelt, or
   // for a split that does not exist).
@@ -295,7 +303,7 @@ class SolidModel {
   // What the line search leaves one Newton iteration (line_search_).
   struct NewtonLineSearch {
     double alpha = 1.0;     // the step taken along du
-    double residual = 0.0;  // ||r|| there (r_, and K_ in exact Newton, assembled there)
+    double residual = 0.0;  // ||r|| there (r_ assembled there)
     bool undone = false;    // an old factorization's step that did not reduce ||r||: u_ back; take the current tangent
     std::string failure;    // non-empty: the solve fails with this message
   };
@@ -348,6 +356,11 @@ class SolidModel {
   // Reference coordinates and current displacements of element e's nodes (rows).
   void element_state_(int e, Eigen::MatrixXd& X, Eigen::MatrixXd& u) const;
   bool pc_current_ = false;  // the preconditioner holds a setup that may be reused (reuse_preconditioner, modified)
+  // NewtonOptions::reuse_parts: the kept splits (indices in part order) and whether their setup may be reused
+  std::vector<int> kept_splits_;
+  bool kept_current_ = false;
+  bool splits_ready_ = false;  // the KSP has been set up once (its splits exist)
+  void keep_splits_(bool keep);  // sets the kept splits' reuse flag (after the first setup)
   double contact_seconds_ = 0.0;  // time in contact_->add() over the model's life (SolveReport::contact_seconds)
   int invalid_element_ = -1;      // invalid_element()
   Vec3d invalid_at_ = Vec3d::Zero();

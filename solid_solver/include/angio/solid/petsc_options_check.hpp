@@ -14,6 +14,7 @@ struct PetscOptionsCheck {
   std::string error;                // PETSc's own message for the first refused option ("" = accepted)
   std::vector<std::string> unused;  // options of `options` no object asked for (typos, or for other objects)
   std::string ksp_type;             // the Krylov method they select (e.g. "preonly", "gmres")
+  bool fieldsplit = false;          // they select -pc_type fieldsplit (one split per part)
 };
 
 // Sets up and runs a KSP with petsc_default_options() and then `options` on a small system (this
