@@ -268,7 +268,7 @@ class SolidModel {
   // centroid of that configuration, for failure messages (same on every rank).
   std::string invalid_element() const;
   Mat matrix() const { return K_; }
-  KSP linear_solver() const { return ksp_; }  // for inspection (its splits, its factorizations)
+  KSP linear_solver() const { return ksp_; }                  // for inspection (its splits, its factorizations)
   int pattern_rebuilds() const { return pattern_rebuilds_; }  // of the matrix by contact pairs new to its pattern
   // The options of ModelOptions::petsc_options no solver object has asked for so far (misspelt, or
   // for a split that does not exist).
@@ -359,8 +359,8 @@ class SolidModel {
   // NewtonOptions::reuse_parts: the kept splits (indices in part order) and whether their setup may be reused
   std::vector<int> kept_splits_;
   bool kept_current_ = false;
-  bool splits_ready_ = false;  // the KSP has been set up once (its splits exist)
-  void keep_splits_(bool keep);  // sets the kept splits' reuse flag (after the first setup)
+  bool splits_ready_ = false;     // the KSP has been set up once (its splits exist)
+  void keep_splits_(bool keep);   // sets the kept splits' reuse flag (after the first setup)
   double contact_seconds_ = 0.0;  // time in contact_->add() over the model's life (SolveReport::contact_seconds)
   int invalid_element_ = -1;      // invalid_element()
   Vec3d invalid_at_ = Vec3d::Zero();
