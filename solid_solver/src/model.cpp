@@ -345,7 +345,7 @@ void SolidModel::setup_petsc_() {
 
 void SolidModel::keep_splits_(bool keep) {
   // the flag is read by each split's own setup inside the next KSPSolve (the splits exist after the first)
-  if (!splits_ready_) return;
+  if (kept_splits_.empty() || !splits_ready_) return;
   PC pc;
   ANGIO_PETSC(KSPGetPC(ksp_, &pc));
   PetscInt n = 0;
@@ -724,7 +724,7 @@ SolidModel::NewtonLineSearch SolidModel::line_search_(SolveReport& rep, const st
   const auto& no = opt_.newton;
   u_base_ = u_;  // the iterate the step starts from (a member: no allocation per Newton iteration)
   const std::vector<double>& u_base = u_base_;
-  // line search (backtracking on ||r||) on residuals alone: a tangent assembly costs about seven
+  // line search (backtracking on ||r||) on residuals alone: a tangent assembly costs several
   // residual ones (element tangents and matrix insertion), so the exact Newton's tangent is assembled
   // once at the accepted iterate, and not at all where that iterate has converged (solve()). alpha
   // ends as the last trial's step. A step of an old factorization (modified Newton) gets no line search: if it

@@ -89,6 +89,23 @@ CASES = [
         lambda s: s["solid"]["newton"].update(tangent="exact", reuse_preconditioner=10),
         "solid.newton.reuse_preconditioner",
     ),
+    # kept splits need a preconditioner split per part, a lag that renews them, and a part of the scene
+    (
+        "reuse_parts without fieldsplit",
+        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_preconditioner=10, reuse_parts=["artery"])
+        or s["solid"].update(petsc_options="-ksp_type fgmres -pc_type lu -pc_factor_mat_solver_type mumps"),
+        "solid.newton.reuse_parts",
+    ),
+    (
+        "reuse_parts without reuse_preconditioner",
+        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_parts=["artery"]),
+        "solid.newton.reuse_parts",
+    ),
+    (
+        "reuse_parts naming a missing part",
+        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_preconditioner=10, reuse_parts=["stent"]),
+        "solid.newton.reuse_parts[0]",
+    ),
     # the virtual insertion tool and the contact switch-on time
     (
         "insertion axis of one point",
