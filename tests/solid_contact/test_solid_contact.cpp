@@ -537,6 +537,11 @@ TEST(BalloonArtery, ConvergesAndMatchesOnOneAndTwoRanks) {
   }
 }
 
+// FGMRES around a block Gauss-Seidel of the two bodies, the balloon's split by LU (the artery's: per test)
+const std::string by_parts =
+    "-ksp_type fgmres -ksp_gmres_restart 100 -pc_type fieldsplit -pc_fieldsplit_type multiplicative "
+    "-fieldsplit_balloon_ksp_type preonly -fieldsplit_balloon_pc_type lu ";
+
 // -pc_type fieldsplit: one split per part, named after it (the balloon by LU, the artery by GMRES
 // with GAMG and its rigid-body modes), the two coupled through the contact by FGMRES. Consistency
 // property: the same converged state as the default solver's; and the options check knows the splits'
@@ -545,10 +550,8 @@ TEST(BalloonArtery, ConvergesAndMatchesOnOneAndTwoRanks) {
 // one run of six (measured); solved, the outer FGMRES needs at most ~150 (12 runs).
 TEST(BalloonArtery, SplitsByPartGiveTheSameState) {
   const BAResult a = balloon_artery_run(PETSC_COMM_WORLD);
-  const char* split =
-      "-ksp_type fgmres -ksp_gmres_restart 100 -pc_type fieldsplit -pc_fieldsplit_type multiplicative "
-      "-fieldsplit_balloon_ksp_type preonly -fieldsplit_balloon_pc_type lu "
-      "-fieldsplit_artery_ksp_type gmres -fieldsplit_artery_ksp_rtol 1e-10 -fieldsplit_artery_pc_type gamg";
+  const std::string split =
+      by_parts + "-fieldsplit_artery_ksp_type gmres -fieldsplit_artery_ksp_rtol 1e-10 -fieldsplit_artery_pc_type gamg";
   const BAResult b = balloon_artery_run(PETSC_COMM_WORLD, split);
   ASSERT_TRUE(a.converged) << a.failure;
   ASSERT_TRUE(b.converged) << b.failure;
@@ -573,10 +576,8 @@ TEST(BalloonArtery, SplitsByPartGiveTheSameState) {
 // balloon's is not.
 TEST(BalloonArtery, KeptArterySplitGivesTheSameState) {
   const BAResult a = balloon_artery_run(PETSC_COMM_WORLD);
-  const char* split =
-      "-ksp_type fgmres -ksp_gmres_restart 100 -ksp_max_it 400 -pc_type fieldsplit -pc_fieldsplit_type multiplicative "
-      "-fieldsplit_balloon_ksp_type preonly -fieldsplit_balloon_pc_type lu "
-      "-fieldsplit_artery_ksp_type preonly -fieldsplit_artery_pc_type lu";
+  const std::string split =
+      by_parts + "-ksp_max_it 400 -fieldsplit_artery_ksp_type preonly -fieldsplit_artery_pc_type lu";
   const BAResult b = balloon_artery_run(PETSC_COMM_WORLD, split, [](NewtonOptions& n) {
     n.reuse_preconditioner = 300;  // above what FGMRES needs here to the test's 1e-13 (up to ~120): never renewed
     n.reuse_parts = {"artery"};
