@@ -336,9 +336,10 @@ void SolidModel::setup_petsc_() {
   const std::vector<std::string> parts = part_names(mesh_);
   for (const auto& name : opt_.newton.reuse_parts) {
     const auto at = std::find(parts.begin(), parts.end(), name);
-    if (!split || at == parts.end() || opt_.newton.reuse_preconditioner <= 0)
+    if (!split || at == parts.end() || opt_.newton.reuse_preconditioner <= 0 || opt_.newton.modified)
       throw std::invalid_argument("newton.reuse_parts: '" + name +
-                                  "' needs -pc_type fieldsplit, a part of the mesh and reuse_preconditioner > 0");
+                                  "' needs -pc_type fieldsplit, a part of the mesh, reuse_preconditioner > 0 "
+                                  "and the exact tangent");
     kept_splits_.push_back(int(at - parts.begin()));
   }
 }

@@ -336,6 +336,9 @@ TEST(Model, ModifiedNewtonGivesTheSameSolutionWithFewerFactorizations) {
   EXPECT_LT(max_diff(u0, u1), 1e-9 * scale);
   EXPECT_LT(max_diff(u0, u2), 1e-9 * scale);
   EXPECT_EQ(exact.factorizations, exact.newton_iterations);
+  // exact Newton: one tangent per iteration, assembled where the iteration starts (a solve's first
+  // residual and line-search trials are residuals alone; none where the solve has converged)
+  EXPECT_EQ(exact.tangent_assemblies, exact.newton_iterations);
   EXPECT_LT(mod.factorizations, 8);                           // fewer than one per step
   EXPECT_GT(mod.newton_iterations, exact.newton_iterations);  // linear instead of quadratic convergence
   EXPECT_LT(mod.tangent_assemblies, mod.newton_iterations);   // most iterations: residual only
