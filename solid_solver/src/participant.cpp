@@ -330,13 +330,12 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
     if (values[b].empty()) continue;
     for (size_t n = 0; n < mesh.X.size(); ++n)
       if (has_node[b * mesh.X.size() + n]) centres[b].push_back(model_->position(int(n)));
-    const std::vector<double> avg =
-        ball_average(centres[b], points[b], point_value[b], point_weight[b], scene_.stress_average_radius);
-    for (size_t i = 0; i < avg.size(); ++i)
-      if (std::isfinite(avg[i]) && !(avg[i] <= bs.max_averaged)) {  // max_averaged starts NaN; an empty ball is NaN
-        bs.max_averaged = avg[i];
-        bs.where_averaged = centres[b][i];
-      }
+    const BallMaximum m =
+        max_ball_average(centres[b], points[b], point_value[b], point_weight[b], scene_.stress_average_radius);
+    if (m.centre != BallMaximum::none) {
+      bs.max_averaged = m.value;
+      bs.where_averaged = centres[b][m.centre];
+    }
   }
 }
 

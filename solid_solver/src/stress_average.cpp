@@ -1,5 +1,6 @@
 #include "angio/solid/stress_average.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -8,37 +9,108 @@
 
 namespace angio::solid {
 
+namespace {
+
+// The sample points in the contact search's AABB tree over their boxes inflated by the radius: a
+// centre's candidates are the points within the radius along every axis, the exact distance decides.
+// Both functions below evaluate a ball through this one class, so their values agree bit for bit.
+class BallSampler {
+ public:
+  BallSampler(const std::vector<Vec3d>& point, const std::vector<double>& value, const std::vector<double>& weight,
+              double radius)
+      : point_(point), value_(value), weight_(weight), r2_(radius * radius) {
+    if (!(radius > 0.0) || !std::isfinite(radius))
+      throw std::invalid_argument("ball_average: the radius must be positive and finite");
+    if (value.size() != point.size() || weight.size() != point.size())
+      throw std::invalid_argument("ball_average: points, values and weights differ in number");
+    std::vector<contact::Aabb> boxes(point.size());
+    for (std::size_t p = 0; p < point.size(); ++p) {
+      boxes[p].extend(point[p]);
+      boxes[p].inflate(radius);
+    }
+    tree_.build(boxes);
+  }
+
+  // Σ w_j f_j / Σ w_j over the points within the radius of c; NaN for an empty ball
+  double average(const Vec3d& c) {
+    near_.clear();
+    tree_.query(c, near_);
+    double sum = 0.0, w = 0.0;
+    for (const int p : near_)
+      if (inside(point_[p], c)) {
+        sum += weight_[p] * value_[p];
+        w += weight_[p];
+      }
+    return w > 0.0 ? sum / w : std::numeric_limits<double>::quiet_NaN();
+  }
+
+  // the one membership test, |x − c|² ≤ r², the same expression from either side
+  bool inside(const Vec3d& x, const Vec3d& c) const { return (x - c).squaredNorm() <= r2_; }
+
+ private:
+  const std::vector<Vec3d>& point_;
+  const std::vector<double>& value_;
+  const std::vector<double>& weight_;
+  double r2_;
+  contact::AabbTree tree_;
+  std::vector<int> near_;
+};
+
+}  // namespace
+
 std::vector<double> ball_average(const std::vector<Vec3d>& centre, const std::vector<Vec3d>& point,
                                  const std::vector<double>& value, const std::vector<double>& weight, double radius) {
-  if (!(radius > 0.0) || !std::isfinite(radius))
-    throw std::invalid_argument("ball_average: the radius must be positive and finite");
-  if (value.size() != point.size() || weight.size() != point.size())
-    throw std::invalid_argument("ball_average: points, values and weights differ in number");
+  BallSampler ball(point, value, weight, radius);
   std::vector<double> out(centre.size(), std::numeric_limits<double>::quiet_NaN());
-  if (point.empty() || centre.empty()) return out;
-  // the contact search's AABB tree over the points' boxes inflated by the radius: a centre's
-  // candidates are the points within the radius along every axis, the exact distance decides
-  std::vector<contact::Aabb> boxes(point.size());
-  for (std::size_t p = 0; p < point.size(); ++p) {
-    boxes[p].extend(point[p]);
-    boxes[p].inflate(radius);
-  }
-  contact::AabbTree tree;
-  tree.build(boxes);
-  const double r2 = radius * radius;
-  std::vector<int> near;
-  for (std::size_t c = 0; c < centre.size(); ++c) {
-    near.clear();
-    tree.query(centre[c], near);
-    double sum = 0.0, w = 0.0;
-    for (const int p : near)
-      if ((point[p] - centre[c]).squaredNorm() <= r2) {
-        sum += weight[p] * value[p];
-        w += weight[p];
-      }
-    if (w > 0.0) out[c] = sum / w;
-  }
+  if (point.empty()) return out;
+  for (std::size_t c = 0; c < centre.size(); ++c) out[c] = ball.average(centre[c]);
   return out;
+}
+
+BallMaximum max_ball_average(const std::vector<Vec3d>& centre, const std::vector<Vec3d>& point,
+                             const std::vector<double>& value, const std::vector<double>& weight, double radius) {
+  BallSampler ball(point, value, weight, radius);
+  BallMaximum best;
+  if (point.empty() || centre.empty()) return best;
+  // A weighted mean never exceeds the largest value it averages: a ball whose average reaches A holds
+  // a point with f ≥ A. Visiting the points by decreasing f and averaging every ball that holds the
+  // point visited, the best average A found so far only grows; once the next point's f is below A,
+  // every ball not yet averaged holds only points below A and cannot reach it. The balls averaged
+  // include every ball whose average is ≥ the final A, so the maximum and its first centre (ties to
+  // the lowest index, as a scan of ball_average's field) are exact. The stop keeps a margin of 1e-10 A
+  // because a computed mean can exceed its largest value by rounding (of order n·eps for n points).
+  std::vector<contact::Aabb> boxes(centre.size());
+  for (std::size_t c = 0; c < centre.size(); ++c) {
+    boxes[c].extend(centre[c]);
+    boxes[c].inflate(radius);
+  }
+  contact::AabbTree centres;
+  centres.build(boxes);
+  std::vector<int> order;  // the points by decreasing value; a non-finite one makes its balls NaN anyway
+  order.reserve(point.size());
+  for (std::size_t p = 0; p < point.size(); ++p)
+    if (std::isfinite(value[p])) order.push_back(int(p));
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return value[a] > value[b]; });
+  std::vector<char> done(centre.size(), 0);
+  std::vector<int> near;
+  for (const int p : order) {
+    if (best.centre != BallMaximum::none && value[p] + 1e-10 * std::abs(best.value) < best.value) break;
+    near.clear();
+    centres.query(point[p], near);
+    std::sort(near.begin(), near.end());
+    for (const int c : near) {
+      if (done[c] || !ball.inside(point[p], centre[c])) continue;
+      done[c] = 1;
+      ++best.balls;
+      const double a = ball.average(centre[c]);
+      if (!std::isfinite(a)) continue;  // a ball of zero weight, as ball_average's NaN
+      if (best.centre == BallMaximum::none || a > best.value || (a == best.value && std::size_t(c) < best.centre)) {
+        best.value = a;
+        best.centre = std::size_t(c);
+      }
+    }
+  }
+  return best;
 }
 
 }  // namespace angio::solid

@@ -10,6 +10,8 @@
 // converges as h/ρ → 0 (the "volume method" of the theory of critical distances, Taylor, The Theory
 // of Critical Distances, 2007, §2.5).
 #pragma once
+#include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "angio/solid/mesh.hpp"
@@ -27,5 +29,18 @@ namespace angio::solid {
 // O(centres · (log points + points per ball)). radius ≤ 0 or non-finite: invalid_argument.
 std::vector<double> ball_average(const std::vector<Vec3d>& centre, const std::vector<Vec3d>& point,
                                  const std::vector<double>& value, const std::vector<double>& weight, double radius);
+
+// The maximum of ball_average over the centres and the first centre that attains it, without averaging
+// every ball: a mean never exceeds its largest value, so only balls around the points with the largest
+// values can hold the maximum (branch and bound; exact, the same value and centre as a scan of
+// ball_average's field). `balls` counts the balls averaged. No centre or no point: value NaN, centre none.
+struct BallMaximum {
+  static constexpr std::size_t none = std::size_t(-1);
+  double value = std::numeric_limits<double>::quiet_NaN();
+  std::size_t centre = none;
+  std::size_t balls = 0;
+};
+BallMaximum max_ball_average(const std::vector<Vec3d>& centre, const std::vector<Vec3d>& point,
+                             const std::vector<double>& value, const std::vector<double>& weight, double radius);
 
 }  // namespace angio::solid
