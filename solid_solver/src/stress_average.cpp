@@ -11,24 +11,29 @@ namespace angio::solid {
 
 namespace {
 
-// The sample points in the contact search's AABB tree over their boxes inflated by the radius: a
-// centre's candidates are the points within the radius along every axis, the exact distance decides.
-// Both functions below evaluate a ball through this one class, so their values agree bit for bit.
+// one box per point, inflated by the radius: the tree over them answers "within the radius along
+// every axis" for a query point, the exact distance decides
+std::vector<contact::Aabb> inflated_boxes(const std::vector<Vec3d>& x, double radius) {
+  std::vector<contact::Aabb> boxes(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    boxes[i].extend(x[i]);
+    boxes[i].inflate(radius);
+  }
+  return boxes;
+}
+
+// The sample points in the contact search's AABB tree (inflated_boxes). Both functions below
+// evaluate a ball through this one class, so their values agree bit for bit.
 class BallSampler {
  public:
   BallSampler(const std::vector<Vec3d>& point, const std::vector<double>& value, const std::vector<double>& weight,
               double radius)
       : point_(point), value_(value), weight_(weight), r2_(radius * radius) {
     if (!(radius > 0.0) || !std::isfinite(radius))
-      throw std::invalid_argument("ball_average: the radius must be positive and finite");
+      throw std::invalid_argument("ball average: the radius must be positive and finite");
     if (value.size() != point.size() || weight.size() != point.size())
-      throw std::invalid_argument("ball_average: points, values and weights differ in number");
-    std::vector<contact::Aabb> boxes(point.size());
-    for (std::size_t p = 0; p < point.size(); ++p) {
-      boxes[p].extend(point[p]);
-      boxes[p].inflate(radius);
-    }
-    tree_.build(boxes);
+      throw std::invalid_argument("ball average: points, values and weights differ in number");
+    tree_.build(inflated_boxes(point, radius));
   }
 
   // Σ w_j f_j / Σ w_j over the points within the radius of c; NaN for an empty ball
@@ -79,13 +84,8 @@ BallMaximum max_ball_average(const std::vector<Vec3d>& centre, const std::vector
   // include every ball whose average is ≥ the final A, so the maximum and its first centre (ties to
   // the lowest index, as a scan of ball_average's field) are exact. The stop keeps a margin of 1e-10 A
   // because a computed mean can exceed its largest value by rounding (of order n·eps for n points).
-  std::vector<contact::Aabb> boxes(centre.size());
-  for (std::size_t c = 0; c < centre.size(); ++c) {
-    boxes[c].extend(centre[c]);
-    boxes[c].inflate(radius);
-  }
   contact::AabbTree centres;
-  centres.build(boxes);
+  centres.build(inflated_boxes(centre, radius));
   std::vector<int> order;  // the points by decreasing value; a non-finite one makes its balls NaN anyway
   order.reserve(point.size());
   for (std::size_t p = 0; p < point.size(); ++p)
@@ -96,8 +96,7 @@ BallMaximum max_ball_average(const std::vector<Vec3d>& centre, const std::vector
   for (const int p : order) {
     if (best.centre != BallMaximum::none && value[p] + 1e-10 * std::abs(best.value) < best.value) break;
     near.clear();
-    centres.query(point[p], near);
-    std::sort(near.begin(), near.end());
+    centres.query(point[p], near);  // in the tree's order: ties go to the lowest index below
     for (const int c : near) {
       if (done[c] || !ball.inside(point[p], centre[c])) continue;
       done[c] = 1;
