@@ -75,6 +75,13 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     std::string failure;
     double smallest = std::numeric_limits<double>::infinity();  // residual, since the last restart
     int k_restart = 0;  // iteration of the last restart: the acceleration counts from there
+    // Stall guard: the residual of the last iteration that halved the mark before it. A step whose
+    // residual has not halved in stall_iterations (15) iterations contracts so slowly that its
+    // max_iterations (50) reduce the residual tenfold at most, less than a step needs; the cut step
+    // is cheaper than the wait.
+    double mark = std::numeric_limits<double>::infinity();
+    int k_mark = 0;
+    bool stalled = false;
     double solid_tolerance = settings.inexact_solid * first_residual_force;
     double step_first_force = 0.0;
     for (int k = 0; k < settings.max_iterations; ++k) {
@@ -134,6 +141,13 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
         smallest = rn;
       }
       smallest = std::min(smallest, rn);
+      if (rn < 0.5 * mark) {
+        mark = rn;
+        k_mark = k;
+      } else if (settings.stall_iterations > 0 && k - k_mark >= settings.stall_iterations) {
+        stalled = true;
+        break;
+      }
       scheme->next_iterate(acc, k - k_restart);
       rep.omega = acc.last_factor();
     }
@@ -153,8 +167,11 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     }
     if (!accept) {
       if (!participant_failed)
-        failure = "coupling did not converge in " + std::to_string(settings.max_iterations) +
-                  " iterations, residual history " + log::list(rep.residuals);
+        failure =
+            (stalled ? "coupling stalled (the residual of iteration " + std::to_string(k_mark) + " not halved in " +
+                           std::to_string(settings.stall_iterations) + " iterations)"
+                     : "coupling did not converge in " + std::to_string(settings.max_iterations) + " iterations") +
+            ", residual history " + log::list(rep.residuals);
       LOG_WARN("step " << rep.step << " t = " << rep.time << " s rejected: " << failure << "; cutting the step");
       beam.end_step(false);
       solid.end_step(false);
@@ -165,8 +182,9 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
       continue;
     }
     if (!converged)
-      LOG_WARN("step " << rep.step << ": coupling not converged after " << rep.iterations << " iterations (residual "
-                       << rep.residuals.back() << "), accepted because coupling.strict is false");
+      LOG_WARN("step " << rep.step << ": coupling " << (stalled ? "stalled, not converged" : "not converged")
+                       << " after " << rep.iterations << " iterations (residual " << rep.residuals.back()
+                       << "), accepted because coupling.strict is false");
     rep.converged = converged;
     constant_retry = false;
     first_residual_force = step_first_force;

@@ -44,6 +44,7 @@ CouplingSettings coupling_settings(const scene::Node& root) {
   s.restart_growth = c->get<double>("restart_growth");
   if (s.restart_growth != 0.0 && !(s.restart_growth > 1.0))
     c->child("restart_growth").fail("0 (never restart) or a factor > 1");
+  s.stall_iterations = c->get<int>("stall_iterations");
   s.prediction = c->get<std::string>("prediction");
   s.record = c->get<bool>("record");
   s.inexact_solid = c->get<double>("inexact_solid");
@@ -61,6 +62,7 @@ std::string settings_json(const CouplingSettings& s) {
                               {"abs_tol", s.abs_tol},
                               {"strict", s.strict},
                               {"restart_growth", s.restart_growth},
+                              {"stall_iterations", s.stall_iterations},
                               {"prediction", s.prediction},
                               {"record", s.record},
                               {"inexact_solid", s.inexact_solid}};

@@ -330,3 +330,67 @@ TEST(CouplingLoop, InexactSolidToleranceFollowsTheCouplingResidual) {
     }
   }
 }
+
+// The stall guard (coupling.stall_iterations), consistency of the loop's bookkeeping on the relaxed
+// map of the wall (eps/kb = 10): constant relaxation omega contracts the residual by 1 − 11 omega per
+// iteration. At 0.95 (halving every 13.5 iterations) the step cannot reach its tolerance; with the
+// guard at 10 every attempt ends after 11 solves (the residual of iteration 0 not halved by
+// iteration 10) instead of max_iterations, and the failure says so; without the guard it uses all 50.
+// At 0.8 (halving every 3.1 iterations) the step converges, and the guard changes nothing.
+namespace {
+coupler::CouplingSettings stall_settings(double rel_tol, int guard) {
+  coupler::CouplingSettings s;
+  s.rel_tol = rel_tol;
+  s.abs_tol = 0.0;
+  s.max_iterations = 50;
+  s.stall_iterations = guard;
+  return s;
+}
+}  // namespace
+
+TEST(CouplingLoop, StallGuardEndsOnlyAStepThatDoesNotHalveItsResidual) {
+  auto t = ramp(1);
+  t.min_step = 0.5;  // one cut
+  for (const int guard : {0, 10}) {
+    test::SpringBeam beam;
+    test::WallSolid wall;
+    coupler::ConstantRelaxation slow(0.05 / 11.0);
+    std::string what;
+    try {
+      coupler::run_coupled(beam, wall, t, stall_settings(1e-8, guard), slow);
+    } catch (const StepFailure& e) {
+      what = e.what();
+    }
+    EXPECT_NE(what.find(guard ? "coupling stalled" : "did not converge in 50"), std::string::npos) << what;
+    EXPECT_EQ(wall.tolerances.size(), guard ? 2u * 11u : 2u * 50u);  // two attempts
+  }
+  std::vector<double> x;
+  std::vector<int> iterations;
+  for (const int guard : {0, 10}) {
+    test::SpringBeam beam;
+    test::WallSolid wall;
+    coupler::ConstantRelaxation steady(0.2 / 11.0);
+    const auto reports = run_ramp(beam, wall, 1, stall_settings(1e-3, guard), steady);
+    ASSERT_EQ(reports.size(), 1u);
+    EXPECT_TRUE(reports[0].converged);
+    EXPECT_GT(reports[0].iterations, 20);  // long enough for the guard to have had its chance
+    iterations.push_back(reports[0].iterations);
+    x.push_back(beam.x_committed[0]);
+  }
+  EXPECT_EQ(iterations[0], iterations[1]);
+  EXPECT_EQ(x[0], x[1]);
+}
+
+// With coupling.strict false a stalled step is accepted as one at max_iterations is: with a warning,
+// not converged, after stall_iterations + 1 iterations.
+TEST(CouplingLoop, StalledStepIsAcceptedWhenNotStrict) {
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  auto s = stall_settings(1e-8, 10);
+  s.strict = false;
+  coupler::ConstantRelaxation slow(0.05 / 11.0);
+  const auto reports = run_ramp(beam, wall, 1, s, slow);
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_FALSE(reports[0].converged);
+  EXPECT_EQ(reports[0].iterations, 11);
+}

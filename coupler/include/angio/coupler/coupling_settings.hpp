@@ -23,6 +23,9 @@ struct CouplingSettings {
   double abs_tol = scene::keys::defaults::coupling_abs_tol;
   bool strict = scene::keys::defaults::coupling_strict;
   double restart_growth = scene::keys::defaults::coupling_restart_growth;
+  // > 0: a step whose coupling residual has not halved in this many iterations ends as at
+  // max_iterations (rejected and cut when strict); 0: only max_iterations ends it.
+  int stall_iterations = scene::keys::defaults::coupling_stall_iterations;
   std::string prediction = scene::keys::defaults::coupling_prediction;
   bool record = scene::keys::defaults::coupling_record;
   // Inexact solid solves: > 0 lets the solid solve coupling iteration k to an absolute residual of
