@@ -76,9 +76,9 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     double smallest = std::numeric_limits<double>::infinity();  // residual, since the last restart
     int k_restart = 0;  // iteration of the last restart: the acceleration counts from there
     // Stall guard: the residual of the last iteration that halved the mark before it. A step whose
-    // residual has not halved in stall_iterations (15) iterations contracts so slowly that its
-    // max_iterations (50) reduce the residual tenfold at most, less than a step needs; the cut step
-    // is cheaper than the wait.
+    // residual has not halved in stall_iterations iterations contracts so slowly that max_iterations
+    // of them reduce it by 2^(max_iterations / stall_iterations) at most (about tenfold with the
+    // declared defaults), less than a step needs; the cut step is cheaper than the wait.
     double mark = std::numeric_limits<double>::infinity();
     int k_mark = 0;
     bool stalled = false;

@@ -141,9 +141,7 @@ void SolidRunner::begin_step(int step, double time) {
   step_ = step;
   time_ = time;
   model_->set_time(time);
-  const bool continuation = scene_.options.newton.continuation > 1;
-  if (continuation) unpredicted_ = model_->state();
-  if (!model_->predict()) unpredicted_.clear();
+  predicted_ = model_->predict();
 }
 
 participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply,
@@ -157,16 +155,16 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
   }
   reset_reply(pts, reply);
   const bool continuation = scene_.options.newton.continuation > 1;
-  const std::vector<double> u_start = !continuation          ? std::vector<double>{}
-                                      : unpredicted_.empty() ? model_->state()
-                                                             : unpredicted_;
+  const std::vector<double> u_start = !continuation ? std::vector<double>{}
+                                      : predicted_  ? model_->committed_state()
+                                                    : model_->state();
   last_ = model_->solve(tolerance);
   totals_.add(last_);
   if (!last_.converged && continuation) last_ = continuation_(pts, u_start, tolerance);
   if (last_.converged) {
     ok_time_ = time_;
     ok_x_ = pts.x;
-    unpredicted_.clear();
+    predicted_ = false;
   }
   if (stent_contact_ && last_.converged) stent_contact_->fill_reply(*model_, reply);
   participant::SolveStats s;

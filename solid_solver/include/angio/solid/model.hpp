@@ -215,6 +215,7 @@ class SolidModel {
   // The whole displacement (new numbering, every rank): a solve's starting point, kept and restored
   // by a continuation within the step (rollback() returns to the committed state instead).
   const std::vector<double>& state() const { return u_; }
+  const std::vector<double>& committed_state() const { return u_committed_; }  // the same numbering
   void restore_state(const std::vector<double>& u) { u_ = u; }
 
   // --- the committed state, as state files keep it (state_file.hpp)

@@ -146,10 +146,10 @@ class SolidRunner : public participant::SolidParticipant {
   // step: where a continuation starts from.
   double ok_time_ = 0.0, committed_ok_time_ = 0.0;
   std::vector<participant::Vec3> ok_x_, committed_ok_x_;
-  // The committed state when the step's first iterate was extrapolated (solid.newton.prediction), until
-  // a solve of the step converges: a continuation starts from the state at ok_time_, not from the
-  // prediction at the step's own time. Empty otherwise.
-  std::vector<double> unpredicted_;
+  // The step's first iterate was extrapolated (solid.newton.prediction) and no solve of the step has
+  // converged yet: a continuation starts from the committed state, the state at ok_time_, not from the
+  // prediction made for the step's own time.
+  bool predicted_ = false;
   SolveReport continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start, double tolerance);
   void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
   void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
