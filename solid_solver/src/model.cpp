@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "angio/solid/load_direction.hpp"
 #include "angio/solid/petsc_options_check.hpp"
 #include "petsc_check.hpp"
 
@@ -975,12 +976,23 @@ bool SolidModel::predict() {
   if (!opt_.newton.extrapolate) return false;
   u_ = u_committed_;
   if (u_before_.size() != u_.size() || !(committed_time_ > before_time_) || !(time_ > committed_time_)) return false;
+  if (!loads_keep_direction(load_levels(before_time_), load_levels(committed_time_), load_levels(time_))) return false;
+  if (contact_ && !contact_->extrapolates(committed_time_, time_)) return false;
   const double f = (time_ - committed_time_) / (committed_time_ - before_time_);
   for (size_t i = 0; i < u_.size(); ++i) u_[i] += f * (u_committed_[i] - u_before_[i]);
   apply_dirichlet_values_();               // prescribed values exact at the new time: no lifting solve for them
   if (assemble(r_, nullptr)) return true;  // collective: false on every rank if any element inverted
   u_ = u_committed_;
   return false;
+}
+
+std::vector<double> SolidModel::load_levels(double t) const {
+  std::vector<double> out;
+  for (const auto& p : pressures_) out.push_back(p.pressure(t));
+  for (const auto& bc : dirichlet_)
+    if (!bc.nodes.empty()) out.push_back(bc.value(mesh_.X[bc.nodes.front()], t));
+  if (contact_) contact_->load_levels(t, out);
+  return out;
 }
 
 void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume,

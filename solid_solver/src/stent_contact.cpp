@@ -133,6 +133,10 @@ void PenaltyStentContact::set_points(const participant::SamplePoints& pts) {
 
 bool PenaltyStentContact::on_(std::size_t k, const SolidModel& model) const { return model.time() >= from_[k]; }
 
+void PenaltyStentContact::load_levels(double t, std::vector<double>& out) const {
+  for (double from : from_) out.push_back(t >= from);
+}
+
 std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const SolidModel& model,
                                                                        std::span<const contact::BeamPoint> points,
                                                                        std::size_t first, bool tangent, bool all) {
@@ -361,6 +365,18 @@ std::vector<NodeCoupling> CompositeContact::couplings(const SolidModel& model) c
 
 std::vector<NodeCoupling> CompositeContact::prepare(const SolidModel& model, bool tangent) {
   return all_couplings(stent_, others_, [&](ContactModel& m) { return m.prepare(model, tangent); });
+}
+
+void CompositeContact::load_levels(double t, std::vector<double>& out) const {
+  if (stent_) stent_->load_levels(t, out);
+  for (const ContactModel* m : others_) m->load_levels(t, out);
+}
+
+bool CompositeContact::extrapolates(double from, double to) const {
+  if (stent_ && !stent_->extrapolates(from, to)) return false;
+  for (const ContactModel* m : others_)
+    if (!m->extrapolates(from, to)) return false;
+  return true;
 }
 
 void CompositeContact::fill_reply(const SolidModel& model, participant::ContactReply& reply) {

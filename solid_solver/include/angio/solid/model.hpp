@@ -50,6 +50,13 @@ class ContactModel {
   // (one rebuild instead of one reallocation of the matrix per new row), and add() then inserts what
   // was evaluated here. The model calls add() only right after prepare() at the same configuration.
   virtual std::vector<NodeCoupling> prepare(const SolidModel&, bool /*tangent*/) { return {}; }
+  // Appends the scalar levels its loading follows at pseudo-time t (a tool's radius; 1 or 0 for a pair
+  // switched on at a time): the model extrapolates a step's first iterate only while every load level
+  // keeps its direction (load_direction.hpp).
+  virtual void load_levels(double /*t*/, std::vector<double>& /*out*/) const {}
+  // Whether a step from pseudo-time `from` to `to` may start from the extrapolated state (false: the
+  // model starts it from the committed state, as where a load turns).
+  virtual bool extrapolates(double /*from*/, double /*to*/) const { return true; }
 };
 
 // The scene's solid.newton keys (core/scene/keys.yaml): meaning and defaults there.
@@ -210,8 +217,13 @@ class SolidModel {
   void rollback();  // back to the last committed state (displacement; the viscous history is only ever committed)
   // First iterate of the step at the current time (newton.extrapolate; collective): the committed
   // state extrapolated along the last committed step, or the committed state itself where there is
-  // no earlier step or the extrapolated state is invalid. Returns whether it extrapolated.
+  // no earlier step, a load turns (loads_keep_direction over load_levels()), the contact model
+  // declines it (ContactModel::extrapolates) or the extrapolated state is invalid. Returns whether
+  // it extrapolated.
   bool predict();
+  // The levels the loads follow at pseudo-time t: each pressure, each prescribed displacement's value
+  // at its first node, then the contact model's (ContactModel::load_levels).
+  std::vector<double> load_levels(double t) const;
   // The whole displacement (new numbering, every rank): a solve's starting point, kept and restored
   // by a continuation within the step (rollback() returns to the committed state instead).
   const std::vector<double>& state() const { return u_; }

@@ -82,6 +82,7 @@ class PenaltyStentContact : public StentContact {
   // With averaged normals a point's tangent couples its face's nodes with the rings of their normals
   // (the nodes of the faces around each); without, it stays within the face (an element's pattern).
   std::vector<NodeCoupling> couplings(const SolidModel& model) const override;
+  void load_levels(double t, std::vector<double>& out) const override;  // 1 or 0 per surface: on at t
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
@@ -144,6 +145,7 @@ class PenaltySurfaceContact : public ContactModel {
   // face pairs within the search radius that no earlier call returned.
   std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
+  void load_levels(double t, std::vector<double>& out) const override { out.push_back(t >= opt_.from); }  // on at t
 
   const ContactSummary& last() const { return last_; }
   double active_area() const { return active_area_; }
@@ -174,6 +176,8 @@ class CompositeContact : public StentContact {
   void add(const SolidModel& model, Vec r, Mat K) override;
   std::vector<NodeCoupling> couplings(const SolidModel& model) const override;        // of all its models
   std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;  // of all its models
+  void load_levels(double t, std::vector<double>& out) const override;                // of all its models
+  bool extrapolates(double from, double to) const override;                           // all its models
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
