@@ -3,7 +3,7 @@
 each discretization knob and reports, per knob and output, the error against the finest run of the
 ladder (or its Richardson extrapolation when three runs show a clean convergence order).
 
-  bench/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,beam]
+  bench/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,artery_size,beam]
                             [--levels KNOB=V1,V2 ...] [--tol 0.01] [--out-dir DIR] [--build-dir DIR]
                             [--reuse JSON|RUN_DIR ...]
 
@@ -13,6 +13,8 @@ Knobs (each ladder holds the scene's own setting, "shipped"; the others are kept
   newton_tol    solid.newton.rtol 1e-4, 1e-6, 1e-8, 1e-10, atol scaled alike (its ratio to rtol kept)
   mesh          balloon/artery divisions x 1, 1.5, 2 per direction (tube generators; a patient
                 artery: patient.mesh.size and refine.size / 1, 1.5, 2)
+  artery_size   a patient artery only: patient.mesh.size in mm, x 1, 1/1.5, 1/2 (refine.size scaled
+                alike); the balloon's mesh kept, so the ladder isolates the wall's discretization
   beam          stent.generator.elements_per_strut (and per connector) 2, 3, 4, 6
 --quick: steps x 1/2, 1, 2; coupling_tol 1e-2, 1e-3, 1e-4; beam 2, 3 (a ladder CI can afford on a
 short scene).
@@ -95,6 +97,14 @@ def _set_mesh(s, f):
             pm["refine"]["size"] /= f  # the fine span refined alike
 
 
+def _set_artery_size(s, size):
+    pm = s["patient"].setdefault("mesh", {})
+    old = pm.get("size", default("patient.mesh.size"))
+    if isinstance(pm.get("refine"), dict) and "size" in pm["refine"]:
+        pm["refine"]["size"] *= size / old  # the fine span keeps its ratio to the rest
+    pm["size"] = size
+
+
 def _set_beam(s, n):
     g = s["stent"]["generator"]
     g["elements_per_strut"] = n
@@ -132,12 +142,15 @@ def knobs(scene, quick, coupling):
     }
     if "generator" not in scene.get("stent", {}):
         out.pop("beam")
+    if isinstance(scene.get("patient"), dict):
+        h = (scene["patient"].get("mesh") or {}).get("size", default("patient.mesh.size"))
+        out["artery_size"] = ([h, h / 1.5, h / 2.0], _set_artery_size, h, "artery element size (mm)", None)
     return out
 
 
 def is_finer(knob, a, b):
     """True when level a is a finer setting than b."""
-    return a < b if knob in ("coupling_tol", "newton_tol") else a > b
+    return a < b if knob in ("coupling_tol", "newton_tol", "artery_size") else a > b
 
 
 # ------------------------------------------------------------------------------------------------
@@ -336,7 +349,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene")
     ap.add_argument("--quick", action="store_true", help="coarse ladders (CI)")
-    ap.add_argument("--knobs", help="comma-separated subset of steps,coupling_tol,newton_tol,mesh,beam")
+    ap.add_argument("--knobs", help="comma-separated subset of steps,coupling_tol,newton_tol,mesh,artery_size,beam")
     ap.add_argument("--tol", type=float, default=0.01, help="relative error a setting must keep (default 1 %%)")
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "work_precision"))
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))

@@ -9,7 +9,10 @@
 #include <map>
 #include <sstream>
 
+#include <sys/resource.h>
+
 #include <nlohmann/json.hpp>
+#include <petsclog.h>
 
 #include "angio/common/log.hpp"
 #include "angio/solid/gather.hpp"
@@ -489,7 +492,26 @@ void SolidRunner::record_and_write_(int step, double time) {
     }
     writer_->write_step(step, time, p1, dir, nodal, owned);
   }
-  if (writer_ && rank_ == 0) write_summary_json_();
+  write_summary_();
+}
+
+void SolidRunner::write_summary_() {
+  if (!writer_) return;
+  // Per rank, gathered on rank 0 for summary.json: the peak resident set (getrusage, KiB on Linux)
+  // and PETSc's own message counters (its vector scatters and matrix assembly, not MUMPS' traffic),
+  // summed as -log_view sums them (each message counted once, half of sends plus receives): the
+  // memory and messages per rank of a scaling study from every run, not from a separate profile
+  // (docs/performance.md, "Solid memory and messages per rank"). One gather per commit.
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const double mine[3] = {double(usage.ru_maxrss),
+                          0.5 * (petsc_irecv_ct + petsc_isend_ct + petsc_recv_ct + petsc_send_ct),
+                          0.5 * (petsc_irecv_len + petsc_isend_len + petsc_recv_len + petsc_send_len)};
+  int size = 1;
+  MPI_Comm_size(comm_, &size);
+  rank_figures_.assign(rank_ == 0 ? 3 * size : 0, 0.0);
+  MPI_Gather(mine, 3, MPI_DOUBLE, rank_figures_.data(), 3, MPI_DOUBLE, 0, comm_);
+  if (rank_ == 0) write_summary_json_();
 }
 
 void SolidRunner::write_summary_json_() const {
@@ -538,6 +560,12 @@ void SolidRunner::write_summary_json_() const {
     const auto& t = totals_;
     int ranks = 1;
     MPI_Comm_size(comm_, &ranks);
+    std::vector<double> peak_mib, messages, message_mib;
+    for (size_t r = 0; r + 2 < rank_figures_.size(); r += 3) {
+      peak_mib.push_back(rank_figures_[r] / 1024.0);
+      messages.push_back(rank_figures_[r + 1]);
+      message_mib.push_back(rank_figures_[r + 2] / (1024.0 * 1024.0));
+    }
     j["timing"] = {{"ranks", ranks},
                    {"dofs", model_->num_dofs()},
                    {"solves", t.solves},
@@ -552,7 +580,13 @@ void SolidRunner::write_summary_json_() const {
                    {"solve_seconds", t.total_seconds},
                    {"stress_recovery_seconds", recovery_seconds_},
                    {"stress_summary_seconds", stress_summary_seconds_},
-                   {"note", "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest"}};
+                   {"peak_memory_mib_per_rank", peak_mib},
+                   {"petsc_messages_per_rank", messages},
+                   {"petsc_message_mib_per_rank", message_mib},
+                   {"note",
+                    "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest; "
+                    "*_per_rank in rank order, so far in the run: the peak resident set (getrusage) and PETSc's "
+                    "messages and their volume as -log_view counts them (not MUMPS' own traffic)"}};
   }
   j["steps"] = ordered_json::array();
   for (const auto& s : history_) {
@@ -643,7 +677,7 @@ void SolidRunner::write_state_() {
 void SolidRunner::finish() {
   if (finished_) return;
   finished_ = true;
-  if (writer_ && rank_ == 0) write_summary_json_();  // the timing of the solves after the last commit
+  write_summary_();  // the timing of the solves after the last commit
   write_state_();
   if (writer_) writer_->close();
 }

@@ -45,8 +45,22 @@ def run(bin_dir, ranks, run_dir):
         return None
     with h5py.File(run_dir / "solid" / "state.h5", "r") as f:
         u = {p: f["parts"][p]["displacement"][...] for p in f["parts"]}
-    steps = json.loads((run_dir / "solid" / "summary.json").read_text())["steps"]
-    return u, steps
+    summary = json.loads((run_dir / "solid" / "summary.json").read_text())
+    mem = summary["timing"].get("peak_memory_mib_per_rank", [])
+    # each rank's peak resident set, gathered: one positive figure per rank, in MiB (a solid rank
+    # holding this mesh, PETSc and MPI takes tens of MiB, never more than the machine)
+    check(
+        len(mem) == ranks and all(10.0 < m < 1e6 for m in mem),
+        f"{ranks} rank(s): summary.json gives each rank's peak memory (got {mem} MiB)",
+    )
+    # PETSc's point-to-point messages: none on one rank, some on every rank of a partition (each
+    # rank shares nodes with another, so its vector scatters and assembly send and receive)
+    msgs = summary["timing"].get("petsc_messages_per_rank", [])
+    check(
+        len(msgs) == ranks and (msgs == [0.0] if ranks == 1 else all(m > 0 for m in msgs)),
+        f"{ranks} rank(s): summary.json gives each rank's PETSc messages (got {msgs})",
+    )
+    return u, summary["steps"]
 
 
 def compare(ranks, ref, other):

@@ -111,6 +111,8 @@ class SolidRunner : public participant::SolidParticipant {
 
  private:
   void record_and_write_(int step, double time);
+  // summary.json on rank 0 after gathering each rank's peak memory and messages. Collective.
+  void write_summary_();
   void write_summary_json_() const;
   // <run>/solid/state.h5 (output.state) with the last committed step, unless already written. Collective.
   void write_state_();
@@ -126,6 +128,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
   double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
   double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (rank 0): max, p99, ball average
+  std::vector<double> rank_figures_;             // per rank: peak resident set (KiB), PETSc messages, bytes (rank 0)
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
