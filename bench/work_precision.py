@@ -90,18 +90,19 @@ def _set_mesh(s, f):
             for layer in m.get("layers", []):
                 n = layer.get("n_radial", default("artery.mesh.layers[0].n_radial"))
                 layer["n_radial"] = max(1, int(round(n * f)))
-    pm = s.get("patient", {}).get("mesh")
-    if isinstance(pm, dict):
-        pm["size"] = pm.get("size", default("patient.mesh.size")) / f
-        if isinstance(pm.get("refine"), dict) and "size" in pm["refine"]:
-            pm["refine"]["size"] /= f  # the fine span refined alike
+    if isinstance(s.get("patient"), dict):
+        _set_artery_size(s, _artery_size(s) / f)
+
+
+def _artery_size(s):
+    """A patient artery's element size (mm), the scene's or the declared default."""
+    return (s["patient"].get("mesh") or {}).get("size", default("patient.mesh.size"))
 
 
 def _set_artery_size(s, size):
     pm = s["patient"].setdefault("mesh", {})
-    old = pm.get("size", default("patient.mesh.size"))
     if isinstance(pm.get("refine"), dict) and "size" in pm["refine"]:
-        pm["refine"]["size"] *= size / old  # the fine span keeps its ratio to the rest
+        pm["refine"]["size"] *= size / _artery_size(s)  # the fine span keeps its ratio to the rest
     pm["size"] = size
 
 
@@ -143,7 +144,7 @@ def knobs(scene, quick, coupling):
     if "generator" not in scene.get("stent", {}):
         out.pop("beam")
     if isinstance(scene.get("patient"), dict):
-        h = (scene["patient"].get("mesh") or {}).get("size", default("patient.mesh.size"))
+        h = _artery_size(scene)
         out["artery_size"] = ([h, h / 1.5, h / 2.0], _set_artery_size, h, "artery element size (mm)", None)
     return out
 

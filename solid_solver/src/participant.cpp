@@ -509,12 +509,12 @@ void SolidRunner::write_summary_() {
                           0.5 * (petsc_irecv_len + petsc_isend_len + petsc_recv_len + petsc_send_len)};
   int size = 1;
   MPI_Comm_size(comm_, &size);
-  rank_figures_.assign(rank_ == 0 ? 3 * size : 0, 0.0);
-  MPI_Gather(mine, 3, MPI_DOUBLE, rank_figures_.data(), 3, MPI_DOUBLE, 0, comm_);
-  if (rank_ == 0) write_summary_json_();
+  std::vector<double> per_rank(rank_ == 0 ? 3 * size : 0);
+  MPI_Gather(mine, 3, MPI_DOUBLE, per_rank.data(), 3, MPI_DOUBLE, 0, comm_);
+  if (rank_ == 0) write_summary_json_(per_rank);
 }
 
-void SolidRunner::write_summary_json_() const {
+void SolidRunner::write_summary_json_(const std::vector<double>& per_rank) const {
   using nlohmann::ordered_json;
   const auto& mesh = model_->mesh();
   auto finite = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr); };
@@ -561,10 +561,10 @@ void SolidRunner::write_summary_json_() const {
     int ranks = 1;
     MPI_Comm_size(comm_, &ranks);
     std::vector<double> peak_mib, messages, message_mib;
-    for (size_t r = 0; r + 2 < rank_figures_.size(); r += 3) {
-      peak_mib.push_back(rank_figures_[r] / 1024.0);
-      messages.push_back(rank_figures_[r + 1]);
-      message_mib.push_back(rank_figures_[r + 2] / (1024.0 * 1024.0));
+    for (size_t r = 0; r + 2 < per_rank.size(); r += 3) {
+      peak_mib.push_back(per_rank[r] / 1024.0);
+      messages.push_back(per_rank[r + 1]);
+      message_mib.push_back(per_rank[r + 2] / (1024.0 * 1024.0));
     }
     j["timing"] = {{"ranks", ranks},
                    {"dofs", model_->num_dofs()},

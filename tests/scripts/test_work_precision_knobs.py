@@ -57,6 +57,19 @@ class ArterySizeKnob(unittest.TestCase):
         wp.knobs(base, False, COUPLING)["artery_size"][1](s, 0.5)
         self.assertEqual(s["patient"]["mesh"], {"size": 0.5})
 
+    def test_mesh_knob_refines_the_wall_alike(self):
+        # the mesh knob refines a patient wall through the same setting (and the balloon besides),
+        # also where the scene gives no patient.mesh (it did not before: the wall stayed coarse)
+        for drop in (False, True):
+            base = scene("patient_like.yaml")
+            if drop:
+                del base["patient"]["mesh"]
+            h = wp.knobs(base, False, COUPLING)["artery_size"][2]
+            s = copy.deepcopy(base)
+            wp.knobs(base, False, COUPLING)["mesh"][1](s, 2.0)
+            self.assertEqual(s["patient"]["mesh"]["size"], h / 2.0)
+            self.assertNotEqual(s["balloon"]["mesh"], base["balloon"]["mesh"])
+
     def test_only_for_a_patient_artery(self):
         for name in ("straight_free_expansion.yaml", "generic_artery.yaml"):
             self.assertNotIn("artery_size", wp.knobs(scene(name), False, COUPLING), name)

@@ -113,7 +113,8 @@ class SolidRunner : public participant::SolidParticipant {
   void record_and_write_(int step, double time);
   // summary.json on rank 0 after gathering each rank's peak memory and messages. Collective.
   void write_summary_();
-  void write_summary_json_() const;
+  // per_rank: each rank's peak resident set (KiB), PETSc messages and their bytes, in rank order.
+  void write_summary_json_(const std::vector<double>& per_rank) const;
   // <run>/solid/state.h5 (output.state) with the last committed step, unless already written. Collective.
   void write_state_();
   int state_step_ = -1;  // committed step the state file holds
@@ -128,7 +129,6 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
   double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
   double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (rank 0): max, p99, ball average
-  std::vector<double> rank_figures_;             // per rank: peak resident set (KiB), PETSc messages, bytes (rank 0)
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
