@@ -84,6 +84,7 @@ ContactSpec read_contact_spec(const Node& root) {
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
   spec.line_averaged_normals = c->get<std::string>("line_normals") == "averaged";
   spec.line_ring_tangent = c->get<std::string>("line_tangent") == "ring";
+  spec.line_force_tangent = c->get<std::string>("line_tangent") != "gap";
   spec.log = c->get<bool>("log");
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);
@@ -126,6 +127,7 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   so.regularization = spec.line_regularization;
   so.averaged_normals = spec.line_averaged_normals;
   so.ring_tangent = spec.line_ring_tangent;
+  so.force_tangent = spec.line_force_tangent;
   if (has_balloon) so.balloon_penalty = spec.stent_balloon;
   if (has_artery) so.artery_penalty = spec.stent_artery;
   so.balloon_from = spec.stent_balloon_from;

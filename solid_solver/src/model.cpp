@@ -789,7 +789,8 @@ double SolidModel::slope_along_(const std::vector<double>& du_full) {
   return global;
 }
 
-void SolidModel::log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale) {
+void SolidModel::log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale,
+                                       const std::vector<double>& du_full) {
   // where the residual is largest: which part of the model keeps Newton from converging
   PetscInt at = -1;
   PetscReal rmax = 0.0;
@@ -808,9 +809,20 @@ void SolidModel::log_newton_iteration_(int it, double res, double alpha, PetscIn
   if (rank_ == 0) {
     const int node = at_global >= 0 ? iperm_[at_global / 3] : -1;
     const Vec3d x = node >= 0 ? position(node) : Vec3d::Zero();
+    // where the Newton step moves a node farthest (the full step, before the line search's alpha):
+    // a step that inverts elements shows where
+    double dmax = 0.0;
+    int dnode = -1;
+    for (size_t a = 0; 3 * a + 2 < du_full.size(); ++a) {
+      const double d = std::hypot(du_full[3 * a], du_full[3 * a + 1], du_full[3 * a + 2]);
+      if (d > dmax) dmax = d, dnode = iperm_[a];
+    }
+    const Vec3d y = dnode >= 0 ? position(dnode) : Vec3d::Zero();
     std::printf(
-        "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)\n",
-        it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1), x(2));
+        "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)  "
+        "max |du| %.2e mm at node %d (%.3f, %.3f, %.3f)\n",
+        it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1), x(2), dmax,
+        dnode, y(0), y(1), y(2));
   }
 }
 
@@ -892,7 +904,7 @@ SolveReport SolidModel::solve(double loose_atol) {
     if (fresh && !converged(step.residual, it + 1) && !assemble_iterate_(rep, true)) return fail(invalid_at(it));
     res = step.residual;
     rep.residual_history.push_back(res);
-    if (no.verbose) log_newton_iteration_(it, res, step.alpha, linear.iterations, stale);
+    if (no.verbose) log_newton_iteration_(it, res, step.alpha, linear.iterations, stale, du_full);
   }
   rep.total_seconds = MPI_Wtime() - t_start;
   rep.contact_seconds = contact_seconds_ - contact_start;

@@ -240,6 +240,50 @@ TEST(NormalField, FaceTangentIsTheRingTangentsFaceColumns) {
   }
 }
 
+// Compares against: the exact tangent, which is affine in the penalty law's force f and stiffness k for one
+// configuration. In the law's linear range (g <= 0) k = eps whatever the regularization g0, while f = eps (g0/2
+// - g) moves with g0; so with LineContactParams::force_tangent = false (contact.line_tangent: gap) the tangent
+// must not change with g0, what it leaves out of the exact one must be f times one matrix, and the residual
+// must be the exact one's. For the averaged-normal kernel (face columns) and the closest-point kernel.
+TEST(NormalField, GapTangentLeavesOutExactlyTheForceTerms) {
+  for (bool averaged : {true, false})
+    for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
+      const test::Mesh m = perturbed_quarter_cylinder(kind, 5);
+      const std::vector<BeamPoint> pts = helix_points();
+      SurfaceSearch S(m.surface, 0.3);
+      if (averaged) S.enable_normal_field();
+      S.update(m.x);
+      const SurfaceSearch* s[] = {&S};
+      auto eval = [&](double g0, bool force) {
+        LineContactParams par;
+        par.penalty = 10.0;
+        par.averaged_normals = averaged;
+        par.ring_tangent = false;
+        par.regularization = g0;
+        par.force_tangent = force;
+        return evaluate_line_contact(pts, s, par);
+      };
+      const double g1 = 0.002, g2 = 0.01;  // both below the points' penetration (about 0.02 mm): linear range
+      const LineContactResult e1 = eval(g1, true), e2 = eval(g2, true), p1 = eval(g1, false), p2 = eval(g2, false);
+      ASSERT_EQ(e1.solid.size(), 12u);
+      ASSERT_EQ(p1.solid.size(), 12u);
+      ASSERT_EQ(p2.solid.size(), 12u);
+      for (std::size_t i = 0; i < e1.solid.size(); ++i) {
+        const int pt = e1.solid[i].point;
+        const double g = e1.per_surface[0][pt].gap;
+        ASSERT_LT(g, 0.0) << name(kind);
+        const double f1 = 10.0 * (g1 / 2 - g), f2 = 10.0 * (g2 / 2 - g);  // eps (g0/2 - g)
+        EXPECT_EQ(p1.solid[i].r, e1.solid[i].r) << name(kind);
+        EXPECT_EQ(p1.solid[i].nodes, e1.solid[i].nodes) << name(kind);
+        const Eigen::MatrixXd& K = p1.solid[i].K;
+        EXPECT_LT((p2.solid[i].K - K).norm(), 1e-12 * K.norm()) << name(kind) << " averaged " << averaged;
+        const Eigen::MatrixXd B1 = (e1.solid[i].K - K) / f1, B2 = (e2.solid[i].K - K) / f2;
+        EXPECT_GT(B1.norm(), 1e-3 * K.norm() / f1) << name(kind);  // the force's terms are there to leave out
+        EXPECT_LT((B1 - B2).norm(), 1e-9 * B1.norm()) << name(kind) << " averaged " << averaged;
+      }
+    }
+}
+
 // Consistency: an update without the normals' derivatives (what a residual-only evaluation asks for) gives the
 // same normals, residual and loads as one with them, and a tangent from it is refused instead of being built
 // from stale derivatives.

@@ -215,7 +215,8 @@ TEST(StentContact, RunnerRingOfPointsConverges) {
 // (1c) Consistency of contact.line_tangent: the face tangent (default) leaves out columns of the averaged
 // normals' exact tangent but not of the residual, so a Newton with it converges to the state of a Newton
 // with the exact (ring) tangent: the same ring of points pressing the balloon gives the same line loads to
-// the Newton tolerance, the face tangent in no fewer iterations (it is not exact).
+// the Newton tolerance, the face tangent in no fewer iterations (it is not exact); so does the gap tangent,
+// which also leaves out the terms of the force's magnitude.
 TEST(StentContact, FaceTangentConvergesToTheRingTangentsState) {
   auto solve = [](const char* tangent, int& iterations) {
     const std::string keys = std::string("  line_normals: averaged\n  line_tangent: ") + tangent + "\n";
@@ -232,19 +233,22 @@ TEST(StentContact, FaceTangentConvergesToTheRingTangentsState) {
     runner.end_step(true);
     return reply.line_loads;
   };
-  int it_ring = 0, it_face = 0;
+  int it_ring = 0, it_face = 0, it_gap = 0;
   const auto ring = solve("ring", it_ring);
-  const auto face = solve("face", it_face);
-  ASSERT_EQ(ring.size(), face.size());
-  double diff = 0, scale = 0;
-  for (size_t i = 0; i < ring.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      diff = std::max(diff, std::abs(ring[i][c] - face[i][c]));
-      scale = std::max(scale, std::abs(ring[i][c]));
-    }
-  EXPECT_GT(scale, 0.0);
-  EXPECT_LT(diff, 1e-8 * scale);
-  EXPECT_GE(it_face, it_ring);
+  for (const char* other : {"face", "gap"}) {  // gap: also without the force's terms (contact.line_tangent)
+    int& it = std::string(other) == "face" ? it_face : it_gap;
+    const auto loads = solve(other, it);
+    ASSERT_EQ(ring.size(), loads.size());
+    double diff = 0, scale = 0;
+    for (size_t i = 0; i < ring.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        diff = std::max(diff, std::abs(ring[i][c] - loads[i][c]));
+        scale = std::max(scale, std::abs(ring[i][c]));
+      }
+    EXPECT_GT(scale, 0.0);
+    EXPECT_LT(diff, 1e-8 * scale) << other;
+    EXPECT_GE(it, it_ring) << other;
+  }
 }
 
 // Three stent points (radius 0.06 mm) pressed 5 um into faces 3, 14 and 22 of the balloon's outer surface.
@@ -659,6 +663,9 @@ TEST(ContactScene, ReadsAndValidates) {
   EXPECT_NE(error("contact: {line_tangent: full}").find("contact.line_tangent"), std::string::npos);
   EXPECT_FALSE(read_contact_spec(node("time: {end: 1}")).line_ring_tangent);  // face: the default
   EXPECT_TRUE(read_contact_spec(node("contact: {line_tangent: ring}")).line_ring_tangent);
+  EXPECT_TRUE(read_contact_spec(node("time: {end: 1}")).line_force_tangent);
+  EXPECT_FALSE(read_contact_spec(node("contact: {line_tangent: gap}")).line_force_tangent);
+  EXPECT_FALSE(read_contact_spec(node("contact: {line_tangent: gap}")).line_ring_tangent);
 }
 
 // The shipped scene parses (solid parts + contact section) and enables balloon-artery contact.

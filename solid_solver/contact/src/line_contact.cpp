@@ -57,7 +57,8 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
   r = -w * f * L.dd.segment(3, m - 3).transpose();
   if (K) {
     const Eigen::RowVectorXd dX = L.dd.segment(3, m - 3);
-    *K = w * (k * dX.transpose() * dX - f * L.hd.bottomRightCorner(m - 3, m - 3));
+    *K = w * k * dX.transpose() * dX;
+    if (par.force_tangent) *K -= w * f * L.hd.bottomRightCorner(m - 3, m - 3);
   }
   if (par.beam_tangent) {
     // q = f n: dq/dx = −k n dd_x + f dn_x
@@ -90,10 +91,12 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
   // r_a = w f nu N_a (= minus the force on face node a); f = f(g), df = −k dg
   for (int a = 0; a < nn; ++a) r.segment<3>(3 * a) = w * f * L.N[a] * proj.nu;
   if (K) {
-    const Eigen::MatrixXd dq = -k * proj.nu * L.dd + f * L.dnu;  // d(f nu)/du, 3 x m
+    // d(f nu)/du, 3 x m; without the force's terms (force_tangent) only the gap's stiffness
+    const double fk = par.force_tangent ? f : 0.0;
+    const Eigen::MatrixXd dq = -k * proj.nu * L.dd + fk * L.dnu;
     for (int a = 0; a < nn; ++a) {
       const Eigen::RowVectorXd dNa = L.dN(a, 0) * L.dxi.row(0) + L.dN(a, 1) * L.dxi.row(1);
-      K->middleRows<3>(3 * a) = w * (L.N[a] * dq + f * proj.nu * dNa).rightCols(6 * nn);
+      K->middleRows<3>(3 * a) = w * (L.N[a] * dq + fk * proj.nu * dNa).rightCols(6 * nn);
     }
   }
   if (par.beam_tangent) pc.dq_dx = -k * proj.nu * L.dd.head<3>() + f * L.dnu.leftCols<3>();

@@ -333,7 +333,8 @@ class SolidModel {
   // Δu·r over all ranks (r_ as assembled, du_full in the global numbering): the energy's slope along du.
   double slope_along_(const std::vector<double>& du_full);
   // The verbose log line of iteration it (rank 0): where the residual is largest, what keeps Newton from converging.
-  void log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale);
+  void log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale,
+                             const std::vector<double>& du_full);
 
   std::vector<double> u_base_;  // line_search_'s starting iterate
   MPI_Comm comm_;

@@ -54,8 +54,9 @@ struct ContactTiming {
   void reset() { *this = {}; }
 };
 
-// contact.line_tangent's default (keys.yaml) as LineContactParams::ring_tangent.
+// contact.line_tangent's default (keys.yaml) as LineContactParams::ring_tangent and ::force_tangent.
 inline constexpr bool kLineRingTangentDefault = std::string_view(scene::keys::defaults::contact_line_tangent) == "ring";
+inline constexpr bool kLineForceTangentDefault = std::string_view(scene::keys::defaults::contact_line_tangent) != "gap";
 
 // A contact pair that is on at every time (the default of `from`).
 inline constexpr double kAlwaysActive = -std::numeric_limits<double>::infinity();
@@ -66,9 +67,10 @@ class PenaltyStentContact : public StentContact {
     std::optional<double> balloon_penalty;                                // N/mm^2; unset: no stent-balloon contact
     std::optional<double> artery_penalty;                                 // N/mm^2; unset: no stent-artery contact
     double search_radius = scene::keys::defaults::contact_search_radius;  // mm; > R + the largest penetration
-    double regularization = 0.0;                  // g0 (mm) of the linear-quadratic law (line_contact.hpp)
-    bool averaged_normals = false;                // projection along the averaged normal field (line_contact.hpp)
-    bool ring_tangent = kLineRingTangentDefault;  // LineContactParams::ring_tangent (averaged normals only)
+    double regularization = 0.0;                    // g0 (mm) of the linear-quadratic law (line_contact.hpp)
+    bool averaged_normals = false;                  // projection along the averaged normal field (line_contact.hpp)
+    bool ring_tangent = kLineRingTangentDefault;    // LineContactParams::ring_tangent (averaged normals only)
+    bool force_tangent = kLineForceTangentDefault;  // LineContactParams::force_tangent
     std::string balloon_surface = "balloon_outer";
     std::string artery_surface = "artery_inner";
     double balloon_from = kAlwaysActive, artery_from = kAlwaysActive;  // s: off before these times

@@ -48,6 +48,14 @@ struct LineContactParams {
   // widen the solid's matrix pattern to the surface's second neighbours, which makes its direct
   // factorization 2.5x dearer on a balloon one element thick (docs/performance.md).
   bool ring_tangent = true;
+  // false: K leaves out the terms proportional to the force's magnitude f (f hd with the closest point;
+  // with averaged normals f dnu, the normal's rotation, and f nu dN_a, the point's slide over the face)
+  // and keeps the penalty's stiffness along the gap, k nu (x) dg/du. A strut pressed into a fine, soft lumen makes the
+  // left-out terms large against the wall's own stiffness (about f/h against E h per node: the ratio grows as 1/h^2)
+  // and the exact tangent indefinite there; Newton's steps then move lumen nodes by millimetres (docs/performance.md,
+  // "The step where the 0.25 mm wall inverts"). Without them Newton converges linearly to the same solution (the
+  // residual is the same). The scene's `contact.line_tangent: gap`.
+  bool force_tangent = true;
   bool compute_tangent = true;  // fill NodalContribution::K
   bool beam_tangent = false;    // fill PointContact::dq_dx
   ProjectionOptions projection;
