@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "angio/participant/penalty_law.hpp"
 #include "helpers.hpp"
 
 using namespace angio::contact;
@@ -272,7 +273,9 @@ TEST(NormalField, GapTangentLeavesOutExactlyTheForceTerms) {
         const int pt = e1.solid[i].point;
         const double g = e1.per_surface[0][pt].gap;
         ASSERT_LT(g, 0.0) << name(kind);
-        const double f1 = 10.0 * (g1 / 2 - g), f2 = 10.0 * (g2 / 2 - g);  // eps (g0/2 - g)
+        const auto l1 = angio::participant::penalty_law(g, g1, 10.0), l2 = angio::participant::penalty_law(g, g2, 10.0);
+        ASSERT_EQ(l1.k, l2.k) << name(kind);  // the linear range: one stiffness, two forces
+        const double f1 = l1.f, f2 = l2.f;
         EXPECT_EQ(p1.solid[i].r, e1.solid[i].r) << name(kind);
         EXPECT_EQ(p1.solid[i].nodes, e1.solid[i].nodes) << name(kind);
         const Eigen::MatrixXd& K = p1.solid[i].K;
