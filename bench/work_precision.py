@@ -3,7 +3,7 @@
 each discretization knob and reports, per knob and output, the error against the finest run of the
 ladder (or its Richardson extrapolation when three runs show a clean convergence order).
 
-  bench/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,artery_size,beam]
+  bench/work_precision.py SCENE [--quick] [--knobs steps,coupling_tol,newton_tol,mesh,artery_size,artery_mesh,beam]
                             [--levels KNOB=V1,V2 ...] [--tol 0.01] [--out-dir DIR] [--build-dir DIR]
                             [--reuse JSON|RUN_DIR ...]
 
@@ -15,6 +15,8 @@ Knobs (each ladder holds the scene's own setting, "shipped"; the others are kept
                 artery: patient.mesh.size and refine.size / 1, 1.5, 2)
   artery_size   a patient artery only: patient.mesh.size in mm, x 1, 1/1.5, 1/2 (refine.size scaled
                 alike); the balloon's mesh kept, so the ladder isolates the wall's discretization
+  artery_mesh   a generated tube artery only (artery.mesh.generator: tube): its divisions x 1, 1.5, 2
+                per direction, the balloon's kept (the same isolation; --levels artery_mesh=0.667,1.5)
   beam          stent.generator.elements_per_strut (and per connector) 2, 3, 4, 6
 --quick: steps x 1/2, 1, 2; coupling_tol 1e-2, 1e-3, 1e-4; beam 2, 3 (a ladder CI can afford on a
 short scene).
@@ -80,18 +82,27 @@ def _set_newton_tol(s, v):
     nw["atol"] = v * ratio
 
 
+def _scale_tube(s, part, f):
+    """A generated tube's divisions (around, along, through each layer) x f, rounded."""
+    m = s.get(part, {}).get("mesh")
+    if isinstance(m, dict) and m.get("generator") == "tube":
+        for k in ("n_circ", "n_axial"):
+            if k in m:
+                m[k] = max(3, int(round(m[k] * f)))
+        for layer in m.get("layers", []):
+            n = layer.get("n_radial", default("artery.mesh.layers[0].n_radial"))
+            layer["n_radial"] = max(1, int(round(n * f)))
+
+
 def _set_mesh(s, f):
     for part in ("balloon", "artery"):
-        m = s.get(part, {}).get("mesh")
-        if isinstance(m, dict) and m.get("generator") == "tube":
-            for k in ("n_circ", "n_axial"):
-                if k in m:
-                    m[k] = max(3, int(round(m[k] * f)))
-            for layer in m.get("layers", []):
-                n = layer.get("n_radial", default("artery.mesh.layers[0].n_radial"))
-                layer["n_radial"] = max(1, int(round(n * f)))
+        _scale_tube(s, part, f)
     if isinstance(s.get("patient"), dict):
         _set_artery_size(s, _artery_size(s) / f)
+
+
+def _set_artery_mesh(s, f):
+    _scale_tube(s, "artery", f)
 
 
 def _artery_size(s):
@@ -143,6 +154,8 @@ def knobs(scene, quick, coupling):
     }
     if "generator" not in scene.get("stent", {}):
         out.pop("beam")
+    if (scene.get("artery", {}).get("mesh") or {}).get("generator") == "tube":
+        out["artery_mesh"] = ([1.0, 1.5, 2.0], _set_artery_mesh, 1.0, "artery mesh refinement x", None)
     if isinstance(scene.get("patient"), dict):
         h = _artery_size(scene)
         out["artery_size"] = ([h, h / 1.5, h / 2.0], _set_artery_size, h, "artery element size (mm)", None)
@@ -350,7 +363,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene")
     ap.add_argument("--quick", action="store_true", help="coarse ladders (CI)")
-    ap.add_argument("--knobs", help="comma-separated subset of steps,coupling_tol,newton_tol,mesh,artery_size,beam")
+    ap.add_argument(
+        "--knobs", help="comma-separated subset of steps,coupling_tol,newton_tol,mesh,artery_size,artery_mesh,beam"
+    )
     ap.add_argument("--tol", type=float, default=0.01, help="relative error a setting must keep (default 1 %%)")
     ap.add_argument("--out-dir", default=os.path.join(ROOT, "runs", "work_precision"))
     ap.add_argument("--build-dir", default=os.path.join(ROOT, "build"))

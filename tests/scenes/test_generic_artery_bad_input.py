@@ -86,7 +86,8 @@ CASES = [
     # the old factorization alone (preonly) would be taken for a solve of the current tangent
     (
         "reuse_preconditioner with preonly",
-        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_preconditioner=10),
+        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_preconditioner=10)
+        or s["solid"].update(petsc_options="-ksp_type preonly -pc_type lu -pc_factor_mat_solver_type mumps"),
         "solid.newton.reuse_preconditioner",
     ),
     # kept splits need a preconditioner split per part, a lag that renews them, and a part of the scene
@@ -98,7 +99,8 @@ CASES = [
     ),
     (
         "reuse_parts without reuse_preconditioner",
-        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_parts=["artery"]),
+        lambda s: s["solid"]["newton"].update(tangent="exact", reuse_parts=["artery"])
+        or s["solid"]["newton"].pop("reuse_preconditioner", None),
         "solid.newton.reuse_parts",
     ),
     (

@@ -6,7 +6,8 @@
 The artery_size knob sets a patient artery's element size and nothing else (the balloon's mesh is
 kept, a refined span keeps its ratio to the rest), is finer when smaller, and is offered only for a
 scene with a patient artery; a variant of it hashes like the same scene written by hand, so a long
-run made with launch.py is taken by --reuse.
+run made with launch.py is taken by --reuse. The artery_mesh knob scales a generated tube artery's
+divisions and nothing else, and is offered only for such a scene.
 """
 import copy
 import sys
@@ -86,6 +87,30 @@ class ArterySizeKnob(unittest.TestCase):
         by_hand = yaml.safe_load(text.replace("mesh: {size: 0.8,", "mesh: {size: 0.533,"))
         self.assertNotEqual(by_hand, base)  # the replacement took
         self.assertEqual(wp.scene_key(s), wp.scene_key(by_hand))
+
+
+class ArteryMeshKnob(unittest.TestCase):
+    def test_ladder_of_the_generic_scene(self):
+        base = scene("generic_artery.yaml")
+        levels, apply, shipped, _, _ = wp.knobs(base, False, COUPLING)["artery_mesh"]
+        self.assertEqual((levels, shipped), ([1.0, 1.5, 2.0], 1.0))
+        m = base["artery"]["mesh"]
+        for f, want in ((0.667, (32, 24, [1, 1])), (1.5, (72, 54, [3, 3]))):  # the ladder study's meshes
+            s = copy.deepcopy(base)
+            apply(s, f)
+            got = s["artery"]["mesh"]
+            self.assertEqual((got["n_circ"], got["n_axial"], [L["n_radial"] for L in got["layers"]]), want)
+            self.assertEqual(s["balloon"], base["balloon"])  # only the wall is refined
+            for k in ("n_circ", "n_axial", "layers"):
+                got[k] = m[k]
+            self.assertEqual(s, base)  # and nothing else changed
+
+    def test_only_for_a_tube_artery(self):
+        for name in ("straight_free_expansion.yaml", "patient_like.yaml"):
+            self.assertNotIn("artery_mesh", wp.knobs(scene(name), False, COUPLING), name)
+
+    def test_larger_is_finer(self):
+        self.assertTrue(wp.is_finer("artery_mesh", 1.5, 1.0))
 
 
 if __name__ == "__main__":
