@@ -164,6 +164,23 @@ void Robin::next_iterate(Acceleration& acc, int k) {
     r.segment<3>(3 * i) = n.dot(p_tilde_.s.segment<3>(3 * i) - p_.s.segment<3>(3 * i)) * n;
   }
   LOG_DEBUG("robin: " << jumped.size() / 3 << " planes appeared or vanished");
+  if (log::enabled(log::Level::debug)) {
+    // per contact surface (plane j of a point): the residual's share and the planes carrying load,
+    // to tell which surface holds the coupling back (a balloon leaving the stent, a wall settling)
+    for (std::size_t j = 0; j < K_; ++j) {
+      double r2 = 0.0;
+      int loaded = 0, switched = 0;
+      for (std::size_t i = j; i < std::size_t(p_.eps.size()); i += K_) {
+        const Eigen::Index ii = Eigen::Index(i);
+        r2 += r.segment<3>(3 * ii).squaredNorm();
+        loaded += f_reply_[ii] > 0.0;
+        switched += f_previous_.size() == f_reply_.size() && (f_reply_[ii] > 0.0) != (f_previous_[ii] > 0.0);
+      }
+      LOG_DEBUG("robin: surface " << j << ": plane residual " << std::sqrt(r2) << ", " << loaded << " planes loaded, "
+                                  << switched << " switched since the last reply");
+    }
+    f_previous_ = f_reply_;
+  }
   acc.mark_discontinuous(std::move(jumped));
   Eigen::VectorXd next = acc.update(p_.s, r, k);
   LOG_DEBUG("robin: plane residual " << r.norm() << ", update " << (next - p_.s).norm());

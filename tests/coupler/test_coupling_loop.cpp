@@ -4,6 +4,7 @@
 // participants are rolled back.
 #include <gtest/gtest.h>
 
+#include "angio/common/log.hpp"
 #include "angio/coupler/aitken.hpp"
 #include "angio/coupler/coupling_loop.hpp"
 #include "angio/coupler/iqn_ils.hpp"
@@ -217,6 +218,33 @@ TEST(CouplingLoop, RobinSurfaceComplianceStartsAgainFromPlainPlanesAfterARejecte
   EXPECT_DOUBLE_EQ(beam.plane_eps[solves_before[3] + 1], wall.eps);
   EXPECT_NEAR(beam.x_committed[0],
               beam.x0 + wall.eps_series(0) * (wall.s_max - wall.x0 - beam.R) / (beam.kb + wall.eps_series(0)), 1e-7);
+}
+
+// The debug log names, per contact surface, the plane residual, the planes carrying load and those
+// that switched since the last reply (which surface holds a step back). One wall: surface 0 only;
+// its four points all loaded once the wall presses, none switching within a step after that.
+TEST(CouplingLoop, RobinDebugLogSplitsTheResidualBySurface) {
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  wall.kw = {0.05, 0.1, 0.2, 0.4};
+  beam.kb = 0.1;
+  coupler::CouplingSettings s;
+  s.scheme = "robin";
+  s.surface_compliance = true;
+  s.rel_tol = 1e-9;
+  s.abs_tol = 1e-12;
+  coupler::IqnIlsOptions o;
+  o.reused_steps = 0;
+  coupler::IqnIls iqn(o);
+  const auto level = log::level();
+  log::set_level(log::Level::debug);
+  testing::internal::CaptureStdout();
+  coupler::run_coupled(beam, wall, ramp(4), s, iqn);
+  const std::string out = testing::internal::GetCapturedStdout();
+  log::set_level(level);
+  EXPECT_NE(out.find("robin: surface 0: plane residual "), std::string::npos) << out;
+  EXPECT_NE(out.find(", 4 planes loaded, 0 switched since the last reply"), std::string::npos) << out;
+  EXPECT_EQ(out.find("robin: surface 1:"), std::string::npos) << out;
 }
 
 TEST(CouplingLoop, RobinSchemeNeedsABeamThatTakesPlanes) {
