@@ -130,6 +130,7 @@ Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const 
   reply_.n = flatten(reply.normals);
   reply_.g0 = reply.regularization;
   reply_.eps = Eigen::Map<const Eigen::VectorXd>(reply.penalty.data(), Eigen::Index(reply.penalty.size()));
+  f_previous_ = std::move(f_reply_);  // every reply's forces, the converged ones included
   f_reply_ = plane_forces(x, reply_);
   // the remainder; softened planes carry the same loads at x, so it holds for either
   c_tilde_ = q_tilde - loads_of(reply_, f_reply_, n);
@@ -179,7 +180,6 @@ void Robin::next_iterate(Acceleration& acc, int k) {
       LOG_DEBUG("robin: surface " << j << ": plane residual " << std::sqrt(r2) << ", " << loaded << " planes loaded, "
                                   << switched << " switched since the last reply");
     }
-    f_previous_ = f_reply_;
   }
   acc.mark_discontinuous(std::move(jumped));
   Eigen::VectorXd next = acc.update(p_.s, r, k);

@@ -220,17 +220,14 @@ TEST(CouplingLoop, RobinSurfaceComplianceStartsAgainFromPlainPlanesAfterARejecte
               beam.x0 + wall.eps_series(0) * (wall.s_max - wall.x0 - beam.R) / (beam.kb + wall.eps_series(0)), 1e-7);
 }
 
-// The debug log names, per contact surface, the plane residual, the planes carrying load and those
-// that switched since the last reply (which surface holds a step back). One wall: surface 0 only;
-// its four points all loaded once the wall presses, none switching within a step after that.
-TEST(CouplingLoop, RobinDebugLogSplitsTheResidualBySurface) {
-  test::SpringBeam beam;
-  test::WallSolid wall;
-  wall.kw = {0.05, 0.1, 0.2, 0.4};
-  beam.kb = 0.1;
+namespace {
+// The coupler's debug output of a robin run (IQN-ILS without reuse, tight tolerances) of `steps`
+// load steps; every accepted step's report into `reports`.
+std::string robin_debug_log(test::SpringBeam& beam, test::WallSolid& wall, int steps, bool surface_compliance,
+                            std::vector<coupler::StepReport>& reports) {
   coupler::CouplingSettings s;
   s.scheme = "robin";
-  s.surface_compliance = true;
+  s.surface_compliance = surface_compliance;
   s.rel_tol = 1e-9;
   s.abs_tol = 1e-12;
   coupler::IqnIlsOptions o;
@@ -239,12 +236,48 @@ TEST(CouplingLoop, RobinDebugLogSplitsTheResidualBySurface) {
   const auto level = log::level();
   log::set_level(log::Level::debug);
   testing::internal::CaptureStdout();
-  coupler::run_coupled(beam, wall, ramp(4), s, iqn);
-  const std::string out = testing::internal::GetCapturedStdout();
+  coupler::run_coupled(beam, wall, ramp(steps), s, iqn, [&](const coupler::StepReport& r) { reports.push_back(r); });
+  std::string out = testing::internal::GetCapturedStdout();
   log::set_level(level);
+  return out;
+}
+}  // namespace
+
+// The debug log names, per contact surface, the plane residual, the planes carrying load and those
+// that switched since the last reply (which surface holds a step back). One wall: surface 0 only;
+// its four points all loaded once the wall presses, none switching within a step after that.
+TEST(CouplingLoop, RobinDebugLogSplitsTheResidualBySurface) {
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  wall.kw = {0.05, 0.1, 0.2, 0.4};
+  beam.kb = 0.1;
+  std::vector<coupler::StepReport> reports;
+  const std::string out = robin_debug_log(beam, wall, 4, true, reports);
   EXPECT_NE(out.find("robin: surface 0: plane residual "), std::string::npos) << out;
   EXPECT_NE(out.find(", 4 planes loaded, 0 switched since the last reply"), std::string::npos) << out;
   EXPECT_EQ(out.find("robin: surface 1:"), std::string::npos) << out;
+}
+
+// The switch count compares with the reply before, also across steps: a wall that reaches the four
+// points only in the second step (s = 1 + 0.2 t against x0 + R = 1.05: free at t = 0.2, pressed at
+// t = 0.4) gives, in that step's first iteration, four planes loaded that were all free in the
+// first step's one (converged) reply.
+TEST(CouplingLoop, RobinDebugLogCountsPlanesThatStartToCarryLoad) {
+  test::SpringBeam beam;
+  test::WallSolid wall;
+  wall.s_max = 1.2;
+  std::vector<coupler::StepReport> reports;
+  const std::string out = robin_debug_log(beam, wall, 5, false, reports);
+  ASSERT_GE(reports.size(), 2u);
+  EXPECT_EQ(reports[0].iterations, 1);  // no contact at t = 0.2: converged at once
+  const auto second = out.find("step 2 iteration 0");
+  ASSERT_NE(second, std::string::npos) << out;
+  EXPECT_EQ(out.substr(0, second).find("robin: surface"), std::string::npos) << out;  // no iterate in step 1
+  const auto line = out.find("robin: surface 0:", second);
+  ASSERT_NE(line, std::string::npos) << out;
+  EXPECT_NE(out.substr(line, out.find('\n', line) - line).find(", 4 planes loaded, 4 switched since the last reply"),
+            std::string::npos)
+      << out;
 }
 
 TEST(CouplingLoop, RobinSchemeNeedsABeamThatTakesPlanes) {

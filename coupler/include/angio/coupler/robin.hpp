@@ -61,7 +61,7 @@ class Robin : public InterfaceScheme {
   bool compliance_ = false;
   Eigen::VectorXd k_;                  // per plane: surface stiffness estimate (N/mm²), 0 unknown
   Eigen::VectorXd f_first_, f_reply_;  // plane forces of first_ and reply_
-  Eigen::VectorXd f_previous_;         // the reply before (debug log only)
+  Eigen::VectorXd f_previous_;         // plane forces of the reply before (the debug log's switches)
   participant::SamplePoints x_;        // positions of the last reply
   bool have_first_ = false;
   Eigen::VectorXd c_, c_tilde_, c_last_;  // remainder loads (two surfaces at one point)
