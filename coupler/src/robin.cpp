@@ -168,6 +168,7 @@ void Robin::next_iterate(Acceleration& acc, int k) {
   if (log::enabled(log::Level::debug)) {
     // per contact surface (plane j of a point): the residual's share and the planes carrying load,
     // to tell which surface holds the coupling back (a balloon leaving the stent, a wall settling)
+    const bool have_previous = f_previous_.size() == f_reply_.size();  // not on the run's first reply
     for (std::size_t j = 0; j < K_; ++j) {
       double r2 = 0.0;
       int loaded = 0, switched = 0;
@@ -175,7 +176,7 @@ void Robin::next_iterate(Acceleration& acc, int k) {
         const Eigen::Index ii = Eigen::Index(i);
         r2 += r.segment<3>(3 * ii).squaredNorm();
         loaded += f_reply_[ii] > 0.0;
-        switched += f_previous_.size() == f_reply_.size() && (f_reply_[ii] > 0.0) != (f_previous_[ii] > 0.0);
+        switched += have_previous && (f_reply_[ii] > 0.0) != (f_previous_[ii] > 0.0);
       }
       LOG_DEBUG("robin: surface " << j << ": plane residual " << std::sqrt(r2) << ", " << loaded << " planes loaded, "
                                   << switched << " switched since the last reply");

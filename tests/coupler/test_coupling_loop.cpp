@@ -233,13 +233,25 @@ std::string robin_debug_log(test::SpringBeam& beam, test::WallSolid& wall, int s
   coupler::IqnIlsOptions o;
   o.reused_steps = 0;
   coupler::IqnIls iqn(o);
-  const auto level = log::level();
-  log::set_level(log::Level::debug);
-  testing::internal::CaptureStdout();
+  // the level and the capture are restored even if the run throws, so that later tests see neither
+  struct DebugCapture {
+    log::Level before = log::level();
+    DebugCapture() {
+      log::set_level(log::Level::debug);
+      testing::internal::CaptureStdout();
+    }
+    std::string take() {
+      taken = true;
+      return testing::internal::GetCapturedStdout();
+    }
+    ~DebugCapture() {
+      if (!taken) testing::internal::GetCapturedStdout();
+      log::set_level(before);
+    }
+    bool taken = false;
+  } capture;
   coupler::run_coupled(beam, wall, ramp(steps), s, iqn, [&](const coupler::StepReport& r) { reports.push_back(r); });
-  std::string out = testing::internal::GetCapturedStdout();
-  log::set_level(level);
-  return out;
+  return capture.take();
 }
 }  // namespace
 
