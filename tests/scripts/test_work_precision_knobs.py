@@ -6,8 +6,11 @@
 The artery_size knob sets a patient artery's element size and nothing else (the balloon's mesh is
 kept, a refined span keeps its ratio to the rest), is finer when smaller, and is offered only for a
 scene with a patient artery; a variant of it hashes like the same scene written by hand, so a long
-run made with launch.py is taken by --reuse. The artery_mesh knob scales a generated tube artery's
-divisions and nothing else, and is offered only for such a scene.
+run made with launch.py is taken by --reuse. The intima_size knob refines the intima alone over the
+balloon's span and nothing else, its shipped level is the scene itself, and a variant hashes like the
+scene written by hand; it is offered only for a patient artery without its own refinement. The
+artery_mesh knob scales a generated tube artery's divisions and nothing else, and is offered only for
+such a scene.
 """
 import copy
 import sys
@@ -87,6 +90,48 @@ class ArterySizeKnob(unittest.TestCase):
         by_hand = yaml.safe_load(text.replace("mesh: {size: 0.8,", "mesh: {size: 0.533,"))
         self.assertNotEqual(by_hand, base)  # the replacement took
         self.assertEqual(wp.scene_key(s), wp.scene_key(by_hand))
+
+
+class IntimaSizeKnob(unittest.TestCase):
+    def test_ladder_of_the_patient_scene(self):
+        base = scene("patient_like.yaml")
+        levels, apply, shipped, _, ratio = wp.knobs(base, False, COUPLING)["intima_size"]
+        self.assertEqual(shipped, base["patient"]["mesh"]["size"])
+        self.assertEqual(levels, [0.8, 0.4, 0.25])  # to the paper's 0.25 mm
+        self.assertIsNone(ratio)
+        s = copy.deepcopy(base)
+        apply(s, shipped)
+        self.assertEqual(s, base)  # the shipped level is the scene itself
+        apply(s, 0.25)
+        self.assertEqual(s["patient"]["mesh"]["refine"], {"size": 0.25, "layers": ["intima"]})
+        self.assertEqual(s["patient"]["mesh"]["size"], shipped)  # the other layers keep the wall's size
+        self.assertEqual(s["balloon"], base["balloon"])
+        del s["patient"]["mesh"]["refine"]
+        self.assertEqual(s, base)  # and nothing else changed
+        apply(s, 0.4)
+        apply(s, shipped)
+        self.assertEqual(s, base)  # back to the shipped level: the refinement is gone again
+
+    def test_variant_hashes_like_the_same_scene_written_by_hand(self):
+        base = scene("patient_like.yaml")
+        s = copy.deepcopy(base)
+        wp.knobs(base, False, COUPLING)["intima_size"][1](s, 0.25)
+        text = (ROOT / "configs" / "patient_like.yaml").read_text()
+        refined = "mesh: {size: 0.8, binary: true, refine: {size: 0.25, layers: [intima]}}"
+        by_hand = yaml.safe_load(text.replace("mesh: {size: 0.8, binary: true}", refined))
+        self.assertNotEqual(by_hand, base)  # the replacement took
+        self.assertEqual(wp.scene_key(s), wp.scene_key(by_hand))
+
+    def test_only_for_a_patient_artery_without_its_own_refinement(self):
+        for name in ("straight_free_expansion.yaml", "generic_artery.yaml"):
+            self.assertNotIn("intima_size", wp.knobs(scene(name), False, COUPLING), name)
+        base = scene("patient_like.yaml")
+        base["patient"]["mesh"]["refine"] = {"size": 0.4}  # its shipped level would not be the scene
+        self.assertNotIn("intima_size", wp.knobs(base, False, COUPLING))
+
+    def test_smaller_is_finer(self):
+        self.assertTrue(wp.is_finer("intima_size", 0.25, 0.8))
+        self.assertFalse(wp.is_finer("intima_size", 0.8, 0.25))
 
 
 class ArteryMeshKnob(unittest.TestCase):
