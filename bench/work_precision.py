@@ -116,9 +116,15 @@ def _artery_size(s):
     return (s["patient"].get("mesh") or {}).get("size", default("patient.mesh.size"))
 
 
+def _refine(s):
+    """A patient artery's own `patient.mesh.refine` map, or None."""
+    r = (s["patient"].get("mesh") or {}).get("refine")
+    return r if isinstance(r, dict) else None
+
+
 def _set_artery_size(s, size):
     pm = s["patient"].setdefault("mesh", {})
-    if isinstance(pm.get("refine"), dict) and "size" in pm["refine"]:
+    if _refine(s) and "size" in pm["refine"]:
         pm["refine"]["size"] *= size / _artery_size(s)  # the fine span keeps its ratio to the rest
     pm["size"] = size
 
@@ -175,7 +181,7 @@ def knobs(scene, quick, coupling):
     if isinstance(scene.get("patient"), dict):
         h = _artery_size(scene)
         out["artery_size"] = ([h, h / 1.5, h / 2.0], _set_artery_size, h, "artery element size (mm)", None)
-        if not isinstance((scene["patient"].get("mesh") or {}).get("refine"), dict):
+        if _refine(scene) is None:
             out["intima_size"] = ([h, h / 2.0, h / 3.2], _set_intima_size, h, "intima element size (mm)", None)
     return out
 
