@@ -112,8 +112,12 @@ int main(int argc, char** argv) {
 #endif
     try {
       angio::solid::SolidRunner runner(PETSC_COMM_WORLD, std::move(scene), cli.get("run-dir"));
-      angio::solid::ContactSetup contact(runner, contact_spec);
       const std::string endpoint = cli.maybe("endpoint").value_or("");
+      // Without a coupler no stent points ever arrive (a procedure's balloon-only phase): the exact
+      // tangent's ring columns would only widen the pattern every factorization pays for
+      // (docs/performance.md "The procedures' contact tangent").
+      if (endpoint.empty()) contact_spec.line_ring_tangent = false;
+      angio::solid::ContactSetup contact(runner, contact_spec);
       if (endpoint.empty()) {
         code = angio::participant::run_standalone(runner, time_settings);
       } else {

@@ -114,7 +114,7 @@ class SolidRunner : public participant::SolidParticipant {
   // summary.json on rank 0 after gathering each rank's peak memory and messages. Collective.
   void write_summary_();
   // per_rank: each rank's peak resident set (KiB), PETSc messages and their bytes, in rank order.
-  void write_summary_json_(const std::vector<double>& per_rank) const;
+  void write_summary_json_(const std::vector<double>& per_rank, double matrix_nonzeros) const;
   // <run>/solid/state.h5 (output.state) with the last committed step, unless already written. Collective.
   void write_state_();
   int state_step_ = -1;  // committed step the state file holds
