@@ -58,7 +58,9 @@ with tempfile.TemporaryDirectory() as t:
     if face and ring:
         nz_face, nz_ring = face.get("matrix_nonzeros"), ring.get("matrix_nonzeros")
         check(nz_face is not None and nz_face > 0, f"summary.json gives the matrix's allocated entries ({nz_face})")
-        check(nz_ring == nz_face, f"ring without a coupler: the elements' pattern ({nz_ring} against {nz_face} entries)")
+        check(
+            nz_ring == nz_face, f"ring without a coupler: the elements' pattern ({nz_ring} against {nz_face} entries)"
+        )
         check(u_face.keys() == u_ring.keys(), "the same parts")
         for p in u_face:
             d = float(np.max(np.abs(u_face[p] - u_ring[p])))
