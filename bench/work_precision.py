@@ -123,10 +123,10 @@ def _refine(s):
 
 
 def _set_artery_size(s, size):
-    pm = s["patient"].setdefault("mesh", {})
-    if _refine(s) and "size" in pm["refine"]:
-        pm["refine"]["size"] *= size / _artery_size(s)  # the fine span keeps its ratio to the rest
-    pm["size"] = size
+    refine = _refine(s)
+    if refine and "size" in refine:
+        refine["size"] *= size / _artery_size(s)  # the fine span keeps its ratio to the rest
+    s["patient"].setdefault("mesh", {})["size"] = size
 
 
 def _set_intima_size(s, size):

@@ -113,10 +113,14 @@ int main(int argc, char** argv) {
     try {
       angio::solid::SolidRunner runner(PETSC_COMM_WORLD, std::move(scene), cli.get("run-dir"));
       const std::string endpoint = cli.maybe("endpoint").value_or("");
-      // Without a coupler no stent points ever arrive (a procedure's balloon-only phase): the exact
-      // tangent's ring columns would only widen the pattern every factorization pays for
-      // (docs/performance.md "The procedures' contact tangent").
-      if (endpoint.empty()) contact_spec.line_ring_tangent = false;
+      // Without a coupler the solid solves with no stent points (run_standalone; a procedure's
+      // balloon-only phase), so it has no stent line contact: none of its couplings (the ring
+      // tangent's columns) widen the pattern every factorization pays for (docs/performance.md
+      // "The procedures' contact tangent"). The same switch as the scene's `stent_*: off`.
+      if (endpoint.empty()) {
+        contact_spec.stent_balloon.reset();
+        contact_spec.stent_artery.reset();
+      }
       angio::solid::ContactSetup contact(runner, contact_spec);
       if (endpoint.empty()) {
         code = angio::participant::run_standalone(runner, time_settings);
