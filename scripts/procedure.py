@@ -170,7 +170,7 @@ def complete(scene, path, out_dir, log=print):
 
     try:
         done, report = prepare_scene(
-            {k: v for k, v in scene.items() if k != "procedure"}, path, out_dir, log=lambda m: log(f"procedure: {m}")
+            _first_tool_in_patient(scene, path), path, out_dir, log=lambda m: log(f"procedure: {m}")
         )
     except PatientInputError as e:
         raise ProcedureError(str(e))
@@ -212,6 +212,29 @@ def complete(scene, path, out_dir, log=print):
         "balloon_centre_station": 0.5 * sum(report["placement"]["balloon_ends_lumen_arc_length"]),
     }
     return done, placement
+
+
+def _first_tool_in_patient(scene, path):
+    """The scene without its procedure, for the patient pipeline, whose tool serves the first phase:
+    the first phase's own insertion keys go to patient.insertion (they would be ignored otherwise); a
+    key set differently in both places is refused."""
+    out = {k: v for k, v in scene.items() if k != "procedure"}
+    first = (scene.get("procedure") or [None])[0]
+    own = first.get("insertion") if isinstance(first, dict) else None
+    if not isinstance(own, dict) or not own or not isinstance(scene.get("patient"), dict):
+        return out
+    scene_keys.check_map(own, "procedure[0].insertion", path, ProcedureError)  # named as written
+    pat = scene["patient"].get("insertion") or {}
+    if not isinstance(pat, dict):
+        return out  # the pipeline's own check names patient.insertion
+    for k, v in own.items():
+        if k in pat and pat[k] != v:
+            raise ProcedureError(
+                f"{path}: procedure[0].insertion.{k}: expected none or patient.insertion.{k}'s value ({pat[k]!r}): "
+                f"the first phase's virtual insertion is the patient pipeline's; got {v!r}"
+            )
+    out["patient"] = {**scene["patient"], "insertion": {**pat, **own}}
+    return out
 
 
 def _own_tool(scene):

@@ -119,6 +119,27 @@ class Plan(unittest.TestCase):
         with self.assertRaisesRegex(procedure.ProcedureError, r"load_curves\.insertion_tool: expected no curve"):
             procedure.complete(s, "s.yaml", "/nonexistent")
 
+    def test_a_patient_first_phase_s_insertion_keys_reach_the_pipeline(self):
+        # the patient pipeline's tool serves the first phase: its keys were silently ignored before
+        s = tiny()
+        s["patient"] = {"insertion": {"clearance": 0.05}}
+        s["procedure"][0]["insertion"] = {"penalty": 30.0}
+        out = procedure._first_tool_in_patient(s, "s.yaml")
+        self.assertNotIn("procedure", out)
+        self.assertEqual(out["patient"]["insertion"], {"clearance": 0.05, "penalty": 30.0})
+        self.assertEqual(s["patient"]["insertion"], {"clearance": 0.05})  # the user's scene unchanged
+        s["procedure"][0]["insertion"] = {"clearance": 0.1}
+        with self.assertRaisesRegex(
+            procedure.ProcedureError, r"procedure\[0\]\.insertion\.clearance: expected none or patient\.insertion"
+        ):
+            procedure._first_tool_in_patient(s, "s.yaml")
+        s["procedure"][0]["insertion"] = {"penalty": -1}
+        with self.assertRaisesRegex(procedure.ProcedureError, r"procedure\[0\]\.insertion\.penalty: expected"):
+            procedure._first_tool_in_patient(s, "s.yaml")
+        s["procedure"][0]["insertion"] = {"penalty": 30.0}
+        del s["patient"]
+        self.assertNotIn("patient", procedure._first_tool_in_patient(s, "s.yaml"))  # not a patient scene
+
     def test_phase_scene_carries_the_tool_and_drops_an_earlier_phase_s(self):
         s = tiny(deploy=[[1.0, 0.0], [1.25, 0.0], [1.5, 1.3], [2.0, 0.0]])
         ph = self.phases(s)
