@@ -219,7 +219,8 @@ def _first_tool_in_patient(scene, path):
     the first phase's own insertion keys go to patient.insertion (they would be ignored otherwise); a
     key set differently in both places is refused."""
     out = {k: v for k, v in scene.items() if k != "procedure"}
-    first = (scene.get("procedure") or [None])[0]
+    proc = scene.get("procedure")
+    first = proc[0] if isinstance(proc, list) and proc else None  # a bad list: named by phases()
     own = first.get("insertion") if isinstance(first, dict) else None
     if not isinstance(own, dict) or not own or not isinstance(scene.get("patient"), dict):
         return out
@@ -235,6 +236,16 @@ def _first_tool_in_patient(scene, path):
             )
     out["patient"] = {**scene["patient"], "insertion": {**pat, **own}}
     return out
+
+
+def pipeline_tool_start(scene):
+    """When the patient pipeline's tool (in the completed scene's contact, on insertion_tool.CURVE)
+    opens a patient procedure's lesion: its curve's first time; None without one."""
+    points = (scene.get("load_curves") or {}).get(insertion_tool.CURVE)
+    ins = (scene.get("contact") or {}).get("insertion")
+    if not points or not isinstance(ins, dict) or _own_tool(scene):
+        return None
+    return float(points[0][0])
 
 
 def _own_tool(scene):
@@ -592,9 +603,10 @@ def summarize(run_dir, scene, path, ran, tools=None, balloon_stations=None):
     # before the procedure: the last step before the first balloon pressure (the prestressed lumen);
     # where the first phase opened the lesion with the insertion tool, the lumen before the tool
     tool0 = (tools or {}).get(ran[0][1]["name"]) if ran else None
+    t_tool = tool0["t0"] if tool0 else pipeline_tool_start(scene)
     before = steps0[0] if steps0 else {}
     for s in steps0:
-        if (s.get("balloon_pressure") or 0.0) > 0.0 or (tool0 and s["time"] > tool0["t0"]):
+        if (s.get("balloon_pressure") or 0.0) > 0.0 or (t_tool is not None and s["time"] > t_tool):
             break
         before = s
     out = {

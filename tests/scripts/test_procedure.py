@@ -5,8 +5,10 @@ in the scene), the pressure-free window it works in (against the load curves' de
 tool's radius curve and the contacts' switch-on time (against the schedule's fractions), and the
 errors naming the key. The runs themselves: configs/stability/procedure_tightest_lumen.yaml."""
 import copy
+import json
 import math
 import sys
+import tempfile
 import unittest
 from pathlib import Path
 
@@ -153,6 +155,33 @@ class Plan(unittest.TestCase):
         two = procedure.phase_scene(first, ph[2], (Path("/r/2-stenting"), True))
         self.assertNotIn("insertion", two["contact"])
         self.assertNotIn("insertion_tool", two["load_curves"])
+
+    def test_the_lumen_before_is_the_one_before_the_patient_pipeline_s_tool(self):
+        # the pipeline's tool (a patient procedure's first phase) opens the lesion from t = -0.2 s and
+        # retracts onto the crimped balloon by t = 0: the lumen before the procedure is the lesion's,
+        # as for a tool the procedure plans itself (it was the one resting on the balloon at t = 0)
+        s = tiny()
+        ph = self.phases(s)[:1]
+        steps = [
+            {"time": -0.2, "balloon_pressure": 0.0, "lumen_diameter": [2.0, 0.7, 2.0]},
+            {"time": -0.1, "balloon_pressure": 0.0, "lumen_diameter": [2.0, 1.4, 2.0]},
+            {"time": 0.0, "balloon_pressure": 0.0, "lumen_diameter": [2.0, 0.9, 2.0]},
+            {"time": 0.5, "balloon_pressure": 1.0, "lumen_diameter": [2.0, 1.5, 2.0]},
+        ]
+        with tempfile.TemporaryDirectory() as tmp:
+            d = procedure.phase_dir(tmp, 0, ph[0]) / "solid"
+            d.mkdir(parents=True)
+            (d / "summary.json").write_text(json.dumps({"lumen_stations": [-1.0, 0.0, 1.0], "steps": steps}))
+            ran = [(0, ph[0], "ok", 1.0)]
+            without = procedure.summarize(tmp, s, "s.yaml", ran)
+            self.assertEqual(without["lumen_before_procedure"]["time"], 0.0)
+            insertion_tool.add_tool(s, -0.2, 0.0, 0.3, 0.7, 30.0)  # as the pipeline writes it
+            out = procedure.summarize(tmp, s, "s.yaml", ran)
+            self.assertEqual(out["lumen_before_procedure"]["time"], -0.2)
+            self.assertEqual(out["phases"][0]["lumen"]["min_diameter_before_procedure"], 0.7)
+            s["load_curves"]["mine"] = s["load_curves"].pop("insertion_tool")
+            s["contact"]["insertion"]["radius"]["curve"] = "mine"  # the scene's own tool: not the pipeline's
+            self.assertIsNone(procedure.pipeline_tool_start(s))
 
     def test_lumen_under_the_balloon(self):
         s = tiny()
