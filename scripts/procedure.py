@@ -685,7 +685,7 @@ def run(scene, path, run_dir, launch_args, completed=None):
                         phase, k, summary, step, placement, (placed or {}).get("stent"), run_dir / "geometry", where
                     )
             # the pipeline's tool (in the scene's contact) already serves a patient's first phase
-            first_has_tool = previous is None and "insertion" in (scene.get("contact") or {})
+            first_has_tool = previous is None and pipeline_tool_start(scene) is not None
             if _tool_may_serve(scene, phase) and not first_has_tool:
                 if previous is None:
                     summary, step = reference_lumen(scene, phase, run_dir, launch_args)
