@@ -262,6 +262,14 @@ void SolidModel::create_matrix_() {
   }
   ANGIO_PETSC(MatAssemblyBegin(K_, MAT_FINAL_ASSEMBLY));
   ANGIO_PETSC(MatAssemblyEnd(K_, MAT_FINAL_ASSEMBLY));
+  std::vector<int> offsets{0};
+  std::vector<PetscInt> element_nodes;
+  for (int e : local_elements_) {
+    const auto& el = mesh_.elements[e];
+    for (int a = 0; a < el.nn(); ++a) element_nodes.push_back(perm_[el.n[a]]);
+    offsets.push_back(int(element_nodes.size()));
+  }
+  slots_.build(K_, node_begin_, node_end_, offsets, element_nodes);
   // rigid-body near null space (for GAMG; harmless otherwise)
   std::vector<PetscInt> owned(nloc);
   std::iota(owned.begin(), owned.end(), node_begin_);
@@ -524,10 +532,17 @@ bool SolidModel::assemble(Vec r, Mat K) {
     }
     if (deformed) X += u;
   };
-  auto add = [&](int nn) {
+  // the element tangents go straight into K_'s arrays where it has slots for them (MatrixSlots)
+  const bool direct = K && slots_.begin(K);
+  // fe and Ke of local element `element` (its index in local_elements_), or of a face (-1)
+  auto add = [&](int nn, long element = -1) {
     const PetscInt m = 3 * nn;
     ANGIO_PETSC(VecSetValues(r, m, idx.data(), fe.data(), ADD_VALUES));
-    if (K) ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
+    if (!K) return;
+    if (direct && element >= 0)
+      slots_.add(size_t(element), Ke, idx);
+    else
+      ANGIO_PETSC(MatSetValues(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES));
   };
   ViscousHistory vh;
   int bad = -1;  // an element this rank found invalid
@@ -541,8 +556,9 @@ bool SolidModel::assemble(Vec r, Mat K) {
       bad = e;
       break;
     }
-    add(el.nn());
+    add(el.nn(), long(i));
   }
+  if (direct) slots_.end();
   for (size_t i = 0; i < pressures_.size() && ok; ++i) {
     const double p = pressures_[i].pressure(time_);
     if (p == 0.0) continue;

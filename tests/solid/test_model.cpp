@@ -164,6 +164,46 @@ TEST(Model, PatchTestSolveAllElementTypes) {
   }
 }
 
+// The element tangents added straight into the matrix's arrays (MatrixSlots) give the matrix that
+// MatSetValues gives, entry for entry and bit for bit (the same sums in the same order), on a deformed
+// distorted cube with a follower pressure; on 2 ranks the element graph's partition puts entries in
+// the off-diagonal block and rows on the other rank. Consistency: two insertion paths, one matrix.
+TEST(Model, DirectInsertionGivesTheMatrixOfMatSetValues) {
+  for (ElemType t : {ElemType::Hex8, ElemType::Tet10}) {
+    Mesh m = angio_test::cube_mesh(t, 4, 0.08, 5);
+    m.surfaces.push_back(faces_at_x1(m));
+    m.orient_surfaces();
+    LayerMaterial mat{"cube", {1.0, 0.4}, {{0.3, 1.0, 20.0, true}}};
+    ModelOptions o = direct_options();
+    o.partitioner = "ptscotch";
+    SolidModel model(PETSC_COMM_WORLD, m, {mat}, o);
+    model.add_pressure({"right", [](double) { return 0.05; }});
+    model.set_time(1.0);
+    std::vector<Vec3d> u(m.X.size());
+    for (size_t n = 0; n < u.size(); ++n) {
+      const Vec3d& X = m.X[n];
+      u[n] = Vec3d(0.1 * std::sin(2.0 * X.y()) * X.z(), 0.08 * X.x() * X.x(), -0.05 * std::cos(X.x() + X.y()));
+    }
+    model.set_displacement(u);
+    ASSERT_TRUE(model.direct_insertion()) << name(t);
+    Mat K = model.matrix(), K2 = nullptr;
+    ASSERT_EQ(0, MatDuplicate(K, MAT_DO_NOT_COPY_VALUES, &K2));
+    ASSERT_EQ(0, MatSetOption(K2, MAT_ROW_ORIENTED, PETSC_FALSE));  // as K_: Eigen's column-major element matrices
+    Vec r2 = nullptr;
+    ASSERT_EQ(0, VecDuplicate(model.residual_vector(), &r2));
+    ASSERT_TRUE(model.assemble(model.residual_vector(), K));  // K_: through the slots
+    ASSERT_TRUE(model.assemble(r2, K2));                      // another matrix: through MatSetValues
+    PetscReal norm = 0.0, diff = -1.0;
+    ASSERT_EQ(0, MatNorm(K, NORM_INFINITY, &norm));
+    ASSERT_EQ(0, MatAXPY(K2, -1.0, K, SAME_NONZERO_PATTERN));
+    ASSERT_EQ(0, MatNorm(K2, NORM_INFINITY, &diff));
+    EXPECT_GT(norm, 1.0) << name(t);
+    EXPECT_EQ(diff, 0.0) << name(t);
+    MatDestroy(&K2);
+    VecDestroy(&r2);
+  }
+}
+
 // Uniaxial compression of a distorted unit cube by a small follower pressure p on the face x = 1
 // (quad4 / tri3 / tri6 faces), rollers on x = 0, y = 0, z = 0: compared with the linear-elastic
 // solution u_x(1) = -p/E, u_y(y=1) = +nu p/E (homogeneous stress, exact for every element type up to

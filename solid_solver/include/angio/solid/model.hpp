@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "angio/solid/matrix_slots.hpp"
 #include "angio/solid/mesh.hpp"
 #include "angio/scene/keys_generated.hpp"
 #include "angio/solid/viscous.hpp"
@@ -283,6 +284,7 @@ class SolidModel {
   Mat matrix() const { return K_; }
   KSP linear_solver() const { return ksp_; }                  // for inspection (its splits, its factorizations)
   int pattern_rebuilds() const { return pattern_rebuilds_; }  // of the matrix by contact pairs new to its pattern
+  bool direct_insertion() const { return slots_.ready(K_); }  // element tangents go straight into K_ (MatrixSlots)
   // The options of ModelOptions::petsc_options no solver object has asked for so far (misspelt, or
   // for a split that does not exist).
   std::vector<std::string> unused_petsc_options() const;
@@ -357,6 +359,7 @@ class SolidModel {
   std::vector<double> u_, u_committed_;  // full copies, new numbering
   std::vector<double> u_before_;         // the commit before u_committed_ (newton.extrapolate)
   double before_time_ = 0.0;
+  MatrixSlots slots_;              // where the local elements' tangents go in K_ (found by create_matrix_)
   Vec damping_diag_ = nullptr;     // η·V_a per owned dof (NewtonOptions::damping); null when off
   Vec damping_tangent_ = nullptr;  // η·V_a/Δt, refilled per assembly (no allocation in Newton)
   double damping_(Vec r, Mat K);
