@@ -1,7 +1,6 @@
 #include "angio/solid/matrix_slots.hpp"
 
 #include <algorithm>
-#include <cstring>
 #include <utility>
 
 #include "petsc_check.hpp"
@@ -52,24 +51,30 @@ struct Csr {
 
 }  // namespace
 
-bool MatrixSlots::build(Mat K, int node_begin, int node_end, const std::vector<int>& offsets,
-                        const std::vector<PetscInt>& nodes) {
+void MatrixSlots::set_items(int node_begin, int node_end, std::vector<int> offsets, std::vector<PetscInt> nodes) {
   ready_ = false;
-  K_ = K;
   node_begin_ = node_begin;
   node_end_ = node_end;
-  MatType type;
-  ANGIO_PETSC(MatGetType(K, &type));
+  offsets_ = std::move(offsets);
+  nodes_ = std::move(nodes);
+}
+
+bool MatrixSlots::build(Mat K) {
+  ready_ = false;
+  K_ = K;
+  PetscBool mpi = PETSC_FALSE, seq = PETSC_FALSE;
+  ANGIO_PETSC(PetscObjectTypeCompare((PetscObject)K, MATMPIAIJ, &mpi));
+  ANGIO_PETSC(PetscObjectTypeCompare((PetscObject)K, MATSEQAIJ, &seq));
   const PetscInt* garray = nullptr;
-  if (std::strcmp(type, MATMPIAIJ) == 0) {
+  if (mpi) {
     ANGIO_PETSC(MatMPIAIJGetSeqAIJ(K, &diag_, &off_, &garray));
-  } else if (std::strcmp(type, MATSEQAIJ) == 0) {
+  } else if (seq) {
     diag_ = K;
     off_ = nullptr;
   } else {
     return false;
   }
-  const PetscInt block_rows = node_end - node_begin;
+  const PetscInt block_rows = node_end_ - node_begin_;
   Csr d, o;
   bool ok = d.borrow(diag_) && d.n == 3 * block_rows;
   // the off-diagonal block's columns are compressed: global column garray[k] is its column k
@@ -95,18 +100,18 @@ bool MatrixSlots::build(Mat K, int node_begin, int node_end, const std::vector<i
   }
   slot_start_.assign(1, 0);
   slot_.clear();
-  for (size_t i = 0; ok && i + 1 < offsets.size(); ++i) {
-    const int n = offsets[i + 1] - offsets[i];
-    const PetscInt* nd = nodes.data() + offsets[i];
+  for (size_t i = 0; ok && i + 1 < offsets_.size(); ++i) {
+    const int n = offsets_[i + 1] - offsets_[i];
+    const PetscInt* nd = nodes_.data() + offsets_[i];
     for (int a = 0; a < n; ++a) {
       const PetscInt pa = nd[a];
-      const bool owned = pa >= node_begin && pa < node_end;
+      const bool owned = pa >= node_begin_ && pa < node_end_;
       for (int b = 0; b < n; ++b) {
         int code = 0;
         if (owned) {
-          const PetscInt r = 3 * (pa - node_begin), pb = nd[b];
-          if (pb >= node_begin && pb < node_end) {
-            const PetscInt at = d.find(r, 3 * (pb - node_begin));
+          const PetscInt r = 3 * (pa - node_begin_), pb = nd[b];
+          if (pb >= node_begin_ && pb < node_end_) {
+            const PetscInt at = d.find(r, 3 * (pb - node_begin_));
             ok = ok && at >= 0;
             code = int(at - d.ia[r]);
           } else {
@@ -130,8 +135,6 @@ bool MatrixSlots::build(Mat K, int node_begin, int node_end, const std::vector<i
       off_rows_.assign(o.ia, o.ia + o.n + 1);
       off_nz_ = o.ia[o.n];
     }
-    offsets_ = offsets;
-    nodes_ = nodes;
   } else {
     slot_.clear();
     slot_start_.clear();
@@ -150,8 +153,7 @@ bool MatrixSlots::begin(Mat K) {
   if (off_) same = same && o.borrow(off_) && o.ia[o.n] == off_nz_;
   d.release();
   o.release();
-  if (!same && !build(K_, node_begin_, node_end_, std::vector<int>(offsets_), std::vector<PetscInt>(nodes_)))
-    return false;
+  if (!same && !build(K_)) return false;
   ANGIO_PETSC(MatSeqAIJGetArray(diag_, &diag_values_));
   if (off_) ANGIO_PETSC(MatSeqAIJGetArray(off_, &off_values_));
   return true;

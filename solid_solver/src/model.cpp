@@ -208,6 +208,15 @@ void SolidModel::partition_() {
   local_elements_.clear();
   for (int e = 0; e < ne; ++e)
     if (elem_rank_[e] == rank_) local_elements_.push_back(e);
+  // the local elements' nodes in the new numbering, where their tangents go (create_matrix_ finds the slots)
+  std::vector<int> offsets{0};
+  std::vector<PetscInt> element_nodes;
+  for (int e : local_elements_) {
+    const auto& el = mesh_.elements[e];
+    for (int a = 0; a < el.nn(); ++a) element_nodes.push_back(perm_[el.n[a]]);
+    offsets.push_back(int(element_nodes.size()));
+  }
+  slots_.set_items(node_begin_, node_end_, std::move(offsets), std::move(element_nodes));
 }
 
 void SolidModel::set_contact(ContactModel* contact) {
@@ -262,14 +271,7 @@ void SolidModel::create_matrix_() {
   }
   ANGIO_PETSC(MatAssemblyBegin(K_, MAT_FINAL_ASSEMBLY));
   ANGIO_PETSC(MatAssemblyEnd(K_, MAT_FINAL_ASSEMBLY));
-  std::vector<int> offsets{0};
-  std::vector<PetscInt> element_nodes;
-  for (int e : local_elements_) {
-    const auto& el = mesh_.elements[e];
-    for (int a = 0; a < el.nn(); ++a) element_nodes.push_back(perm_[el.n[a]]);
-    offsets.push_back(int(element_nodes.size()));
-  }
-  slots_.build(K_, node_begin_, node_end_, offsets, element_nodes);
+  slots_.build(K_);
   // rigid-body near null space (for GAMG; harmless otherwise)
   std::vector<PetscInt> owned(nloc);
   std::iota(owned.begin(), owned.end(), node_begin_);

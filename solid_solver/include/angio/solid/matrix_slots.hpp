@@ -21,12 +21,14 @@ namespace angio::solid {
 
 class MatrixSlots {
  public:
-  // Finds the slots of the items' node pairs (nodes in the matrix's block numbering, item after
-  // item: item i has the nodes nodes[offsets[i] .. offsets[i+1])) in K, a (Seq|MPI)AIJ matrix with
-  // block size 3, assembled with its whole pattern, whose block rows [node_begin, node_end) this rank
-  // owns. False (and no slots) where K is of another type or its pattern is not node-blocked: the
+  // The items whose matrices add() places (nodes in the matrix's block numbering, item after item:
+  // item i has the nodes nodes[offsets[i] .. offsets[i+1])) and the block rows [node_begin, node_end)
+  // this rank owns. Once: they do not change with the matrix's pattern.
+  void set_items(int node_begin, int node_end, std::vector<int> offsets, std::vector<PetscInt> nodes);
+  // Finds the items' slots in K, a (Seq|MPI)AIJ matrix with block size 3 assembled with its whole
+  // pattern. False (and no slots) where K is of another type or its pattern is not node-blocked: the
   // caller then inserts with MatSetValues.
-  bool build(Mat K, int node_begin, int node_end, const std::vector<int>& offsets, const std::vector<PetscInt>& nodes);
+  bool build(Mat K);
   bool ready(Mat K) const { return ready_ && K == K_; }
 
   // Between begin() and end() (K's value arrays open), add() adds item i's matrix Ke (column-major,
