@@ -46,14 +46,6 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
   if (materials_.size() != mesh_.blocks.size())
     throw std::runtime_error("solid model: " + std::to_string(mesh_.blocks.size()) + " blocks but " +
                              std::to_string(materials_.size()) + " materials");
-  fibers_.resize(mesh_.elements.size());
-  for (size_t e = 0; e < mesh_.elements.size(); ++e) {
-    const auto& mat = materials_[mesh_.elements[e].block];
-    if (!mat.fibers.empty())
-      fibers_[e] =
-          resolve_fibers(mat, mesh_.frames.size() == mesh_.elements.size() ? mesh_.frames[e]
-                                                                           : element_frame(mesh_, int(e), opt_.axis));
-  }
   // reference Jacobians must be positive (the scene reader refuses inverted meshes; this guards
   // meshes built in code)
   if (const std::string bad = first_invalid_element(mesh_); !bad.empty())
@@ -74,6 +66,15 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
     }
   }
   partition_();
+  // fiber families of this rank's elements only: what the kernels read (whole-mesh per rank otherwise)
+  fibers_.resize(local_elements_.size());
+  for (size_t i = 0; i < local_elements_.size(); ++i) {
+    const int e = local_elements_[i];
+    const auto& mat = materials_[mesh_.elements[e].block];
+    if (!mat.fibers.empty())
+      fibers_[i] = resolve_fibers(
+          mat, mesh_.frames.size() == mesh_.elements.size() ? mesh_.frames[e] : element_frame(mesh_, e, opt_.axis));
+  }
   setup_petsc_();
   if (opt_.newton.damping > 0.0) {
     // η·V_a per dof: each owned element adds η·V_e/n_e to its nodes (a lumped "mass" of unit density)
@@ -553,7 +554,7 @@ bool SolidModel::assemble(Vec r, Mat K) {
     const auto& el = mesh_.elements[e];
     gather_nodes(el.n.data(), el.nn(), false);
     const auto& mat = materials_[el.block].matrix;
-    if (!element_internal(el.type, X, u, mat, fibers_[e], fe, K ? &Ke : nullptr, nullptr, viscous_history_(i, vh))) {
+    if (!element_internal(el.type, X, u, mat, fibers_[i], fe, K ? &Ke : nullptr, nullptr, viscous_history_(i, vh))) {
       ok = 0;
       bad = e;
       break;
@@ -983,7 +984,7 @@ void SolidModel::commit() {
       const int e = local_elements_[i];
       const auto& el = mesh_.elements[e];
       element_state_(e, X, u);
-      element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, nullptr, &vh);
+      element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[i], fe, nullptr, nullptr, &vh);
     }
   }
   if (opt_.newton.extrapolate) {
@@ -1039,7 +1040,7 @@ void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir
     element_state_(e, X, u);
     ElementStress es;
     ViscousHistory vh;
-    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[e], fe, nullptr, &es, viscous_history_(i, vh));
+    element_internal(el.type, X, u, materials_[el.block].matrix, fibers_[i], fe, nullptr, &es, viscous_history_(i, vh));
     Eigen::SelfAdjointEigenSolver<Mat3> eig(es.cauchy_avg);
     p1[i] = eig.eigenvalues()(2);
     dir[i] = eig.eigenvectors().col(2);

@@ -15,8 +15,8 @@
 #include <petsclog.h>
 
 #include "angio/common/log.hpp"
+#include "angio/solid/element_stress_summary.hpp"
 #include "angio/solid/gather.hpp"
-#include "angio/solid/stress_average.hpp"
 #include "petsc_check.hpp"
 
 namespace angio::solid {
@@ -28,7 +28,10 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
   MPI_Comm_size(comm_, &size);
   if (rank_ == 0 && scene_.ranks > 0 && scene_.ranks != size)
     LOG_WARN("solid.ranks is " << scene_.ranks << " but the solver runs on " << size << " MPI ranks");
-  model_ = std::make_unique<SolidModel>(comm_, scene_.mesh, scene_.materials, scene_.options);
+  // the model owns the mesh (model().mesh()): a copy kept in the scene would hold the whole mesh
+  // twice on every rank
+  model_ = std::make_unique<SolidModel>(comm_, std::move(scene_.mesh), scene_.materials, scene_.options);
+  scene_.mesh = Mesh{};
   for (const auto& p : scene_.pressures) {
     const PressureSpec ps = p;
     model_->add_pressure({p.surface, [ps](double t) { return ps.value * ps.curve.value(t); }});
@@ -141,6 +144,15 @@ void SolidRunner::balloon_diameters(double& mid, double& end0, double& end1) con
   end1 = diam(ring_end1_);
 }
 
+namespace {
+// The process's peak resident set so far (getrusage, KiB on Linux).
+long peak_resident_kib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss;
+}
+}  // namespace
+
 void SolidRunner::begin_step(int step, double time) {
   step_ = step;
   time_ = time;
@@ -158,6 +170,7 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
     warned_contact_ = true;
   }
   reset_reply(pts, reply);
+  if (setup_peak_kib_ < 0) setup_peak_kib_ = peak_resident_kib();
   const bool continuation = scene_.options.newton.continuation > 1;
   const std::vector<double> u_start = !continuation ? std::vector<double>{}
                                       : predicted_  ? model_->committed_state()
@@ -271,78 +284,15 @@ void SolidRunner::end_step(bool accept) {
 }
 
 void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const {
-  // every local element as (element, p1, reference volume) gathered on rank 0, which holds the whole
-  // mesh and the current positions of all nodes
-  const auto& mesh = model_->mesh();
-  const auto& le = model_->local_elements();
-  std::vector<double> mine;
-  mine.reserve(3 * le.size());
-  for (size_t i = 0; i < le.size(); ++i) mine.insert(mine.end(), {double(le[i]), p1[i], vol[i]});
-  const std::vector<double> all = gather_on_root(comm_, mine);
-  const size_t nb = mesh.blocks.size();
-  s.stress.assign(nb, BlockStress{});
+  const std::vector<ElementStressSummary> e =
+      element_stress_summary(comm_, *model_, p1, vol, scene_.stress_average_radius);
+  s.stress.assign(e.size(), BlockStress{});
   if (rank_ != 0) return;
-  // per block: element values and volumes (max, p99); for the ball average (stress_average.hpp) the
-  // elements' Gauss points in the current configuration, each with the element's value and its share
-  // w_q / Σw of the element's reference volume, and the centres: element centroids, then the nodes
-  std::vector<std::vector<double>> values(nb), weights(nb), point_value(nb), point_weight(nb);
-  std::vector<std::vector<Vec3d>> centres(nb), points(nb);
-  std::vector<char> has_node(nb * mesh.X.size(), 0);
-  std::vector<double> best(nb, -std::numeric_limits<double>::infinity());
-  // shape functions at the Gauss points and their volume shares w_q / Σw, once per element type
-  std::map<ElemType, std::pair<std::vector<Eigen::VectorXd>, std::vector<double>>> at_gauss;
-  auto gauss_of = [&](ElemType t) -> const auto& {
-    auto [it, fresh] = at_gauss.try_emplace(t);
-    if (fresh) {
-      const auto& rule = volume_rule(t);
-      double wsum = 0.0;
-      for (const auto& q : rule) wsum += q.w;
-      Eigen::MatrixXd dN;
-      for (const auto& q : rule) {
-        it->second.first.emplace_back();
-        shape(t, q.xi, it->second.first.back(), dN);
-        it->second.second.push_back(q.w / wsum);
-      }
-    }
-    return it->second;
-  };
-  for (size_t k = 0; k + 2 < all.size(); k += 3) {
-    const auto& el = mesh.elements[size_t(all[k])];
-    const int b = el.block;
-    const double v = all[k + 1], volume = all[k + 2];
-    values[b].push_back(v);
-    weights[b].push_back(volume);
-    Vec3d c = Vec3d::Zero();
-    for (int a = 0; a < el.nn(); ++a) {
-      c += model_->position(el.n[a]);
-      has_node[size_t(b) * mesh.X.size() + size_t(el.n[a])] = 1;
-    }
-    centres[b].push_back(c / double(el.nn()));
-    if (v > best[b]) {
-      best[b] = v;
-      s.stress[b].where = centres[b].back();
-    }
-    const auto& [N, share] = gauss_of(el.type);
-    for (size_t q = 0; q < N.size(); ++q) {
-      Vec3d x = Vec3d::Zero();
-      for (int a = 0; a < el.nn(); ++a) x += N[q](a) * model_->position(el.n[a]);
-      points[b].push_back(x);
-      point_value[b].push_back(v);
-      point_weight[b].push_back(volume * share[q]);
-    }
-  }
-  for (size_t b = 0; b < nb; ++b) {
-    BlockStress& bs = s.stress[b];
-    bs.p99 = weighted_quantile(values[b], weights[b], 0.99);
-    if (values[b].empty()) continue;
-    for (size_t n = 0; n < mesh.X.size(); ++n)
-      if (has_node[b * mesh.X.size() + n]) centres[b].push_back(model_->position(int(n)));
-    const BallMaximum m =
-        max_ball_average(centres[b], points[b], point_value[b], point_weight[b], scene_.stress_average_radius);
-    if (m.centre != BallMaximum::none) {
-      bs.max_averaged = m.value;
-      bs.where_averaged = centres[b][m.centre];
-    }
+  for (size_t b = 0; b < e.size(); ++b) {
+    s.stress[b].where = e[b].where;
+    s.stress[b].p99 = e[b].p99;
+    s.stress[b].max_averaged = e[b].max_averaged;
+    s.stress[b].where_averaged = e[b].where_averaged;
   }
 }
 
@@ -503,15 +453,16 @@ void SolidRunner::write_summary_() {
   // summed as -log_view sums them (each message counted once, half of sends plus receives): the
   // memory and messages per rank of a scaling study from every run, not from a separate profile
   // (docs/performance.md, "Solid memory and messages per rank"). One gather per commit.
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  const double mine[3] = {double(usage.ru_maxrss),
+  // The peak before the first solve splits what the setup holds (the mesh every rank reads, the model,
+  // the matrix's pattern, the contact's structures) from what the solves add (the factorizations).
+  const double mine[4] = {double(peak_resident_kib()),
                           0.5 * (petsc_irecv_ct + petsc_isend_ct + petsc_recv_ct + petsc_send_ct),
-                          0.5 * (petsc_irecv_len + petsc_isend_len + petsc_recv_len + petsc_send_len)};
+                          0.5 * (petsc_irecv_len + petsc_isend_len + petsc_recv_len + petsc_send_len),
+                          double(setup_peak_kib_ < 0 ? peak_resident_kib() : setup_peak_kib_)};
   int size = 1;
   MPI_Comm_size(comm_, &size);
-  std::vector<double> per_rank(rank_ == 0 ? 3 * size : 0);
-  MPI_Gather(mine, 3, MPI_DOUBLE, per_rank.data(), 3, MPI_DOUBLE, 0, comm_);
+  std::vector<double> per_rank(rank_ == 0 ? 4 * size : 0);
+  MPI_Gather(mine, 4, MPI_DOUBLE, per_rank.data(), 4, MPI_DOUBLE, 0, comm_);
   // the matrix's allocated entries (its pattern, contact couplings included): what every
   // factorization's fill starts from
   MatInfo info{};
@@ -565,11 +516,12 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
     const auto& t = totals_;
     int ranks = 1;
     MPI_Comm_size(comm_, &ranks);
-    std::vector<double> peak_mib, messages, message_mib;
-    for (size_t r = 0; r + 2 < per_rank.size(); r += 3) {
+    std::vector<double> peak_mib, messages, message_mib, setup_mib;
+    for (size_t r = 0; r + 3 < per_rank.size(); r += 4) {
       peak_mib.push_back(per_rank[r] / 1024.0);
       messages.push_back(per_rank[r + 1]);
       message_mib.push_back(per_rank[r + 2] / (1024.0 * 1024.0));
+      setup_mib.push_back(per_rank[r + 3] / 1024.0);
     }
     j["timing"] = {{"ranks", ranks},
                    {"dofs", model_->num_dofs()},
@@ -587,12 +539,15 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
                    {"stress_recovery_seconds", recovery_seconds_},
                    {"stress_summary_seconds", stress_summary_seconds_},
                    {"peak_memory_mib_per_rank", peak_mib},
+                   {"setup_memory_mib_per_rank", setup_mib},
                    {"petsc_messages_per_rank", messages},
                    {"petsc_message_mib_per_rank", message_mib},
                    {"note",
                     "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest; "
-                    "*_per_rank in rank order, so far in the run: the peak resident set (getrusage) and PETSc's "
-                    "messages and their volume as -log_view counts them (not MUMPS' own traffic)"}};
+                    "*_per_rank in rank order, so far in the run: the peak resident set (getrusage), the same before "
+                    "the first solve (setup: libraries, the mesh, the model, the matrix's pattern, the contact's "
+                    "structures) and PETSc's messages and their volume as -log_view counts them (not MUMPS' own "
+                    "traffic)"}};
   }
   j["steps"] = ordered_json::array();
   for (const auto& s : history_) {

@@ -53,6 +53,13 @@ def run(bin_dir, ranks, run_dir):
         len(mem) == ranks and all(10.0 < m < 1e6 for m in mem),
         f"{ranks} rank(s): summary.json gives each rank's peak memory (got {mem} MiB)",
     )
+    # the peak before the first solve: one per rank, positive and not above the run's peak
+    setup = summary["timing"].get("setup_memory_mib_per_rank", [])
+    check(
+        len(setup) == ranks and all(0.0 < s <= m for s, m in zip(setup, mem)),
+        f"{ranks} rank(s): summary.json gives each rank's memory before the first solve, at most its peak "
+        f"(got {setup} against {mem} MiB)",
+    )
     # PETSc's point-to-point messages: none on one rank, some on every rank of a partition (each
     # rank shares nodes with another, so its vector scatters and assembly send and receive)
     msgs = summary["timing"].get("petsc_messages_per_rank", [])

@@ -344,7 +344,7 @@ class SolidModel {
   Mesh mesh_;
   std::vector<LayerMaterial> materials_;
   ModelOptions opt_;
-  std::vector<std::vector<FiberFamily>> fibers_;  // per element
+  std::vector<std::vector<FiberFamily>> fibers_;  // per local element (local_elements_ order)
   std::vector<int> elem_rank_, node_owner_, perm_, iperm_, local_elements_;
   int node_begin_ = 0, node_end_ = 0;
   std::vector<PressureLoad> pressures_;

@@ -94,7 +94,7 @@ class SolidRunner : public participant::SolidParticipant {
   void finish() override;
 
   SolidModel& model() { return *model_; }
-  const SolidScene& scene() const { return scene_; }
+  const SolidScene& scene() const { return scene_; }  // its mesh was moved into the model: model().mesh()
   // Registers the stent contact (not owned; nullptr: no stent contact, zero line loads).
   void set_stent_contact(StentContact* contact) {
     stent_contact_ = contact;
@@ -113,7 +113,8 @@ class SolidRunner : public participant::SolidParticipant {
   void record_and_write_(int step, double time);
   // summary.json on rank 0 after gathering each rank's peak memory and messages. Collective.
   void write_summary_();
-  // per_rank: each rank's peak resident set (KiB), PETSc messages and their bytes, in rank order.
+  // per_rank: each rank's peak resident set (KiB), PETSc messages and their bytes and its peak resident set
+  // before the first solve (KiB), in rank order.
   void write_summary_json_(const std::vector<double>& per_rank, double matrix_nonzeros) const;
   // <run>/solid/state.h5 (output.state) with the last committed step, unless already written. Collective.
   void write_state_();
@@ -128,11 +129,12 @@ class SolidRunner : public participant::SolidParticipant {
   std::unique_ptr<StressRecovery> recovery_;     // recovered nodal stresses per layer
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
   double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
-  double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (rank 0): max, p99, ball average
+  double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (on rank 0): max, p99, ball average
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
-  SolveTotals totals_;  // every solve of the run, rejected steps included
+  SolveTotals totals_;        // every solve of the run, rejected steps included
+  long setup_peak_kib_ = -1;  // peak resident set before the first solve: mesh, model, matrix, contact built
   int step_ = 0;
   int committed_ = 0;
   double time_ = 0.0;
@@ -155,6 +157,7 @@ class SolidRunner : public participant::SolidParticipant {
   bool predicted_ = false;
   SolveReport continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start, double tolerance);
   void artery_measures_(StepSummary& s, std::vector<double>& contact_pressure);
+  // element_stress_summary.hpp into s.stress (rank 0); collective
   void block_stress_(const std::vector<double>& p1, const std::vector<double>& vol, StepSummary& s) const;
   void nodal_stress_(StepSummary& s) const;  // from recovery_, into s.stress (rank 0)
   void write_apposition_csv_(const std::vector<double>& gap, const std::vector<double>& weight) const;
