@@ -80,7 +80,8 @@ void exchange_points(MPI_Comm comm, std::vector<BlockShare>& share, double radiu
   for (int r = 0; r < size; ++r) {
     if (r == rank) continue;
     std::unordered_set<Cell, CellHash> theirs;
-    for (int k = displs[r]; k + 3 < displs[r] + counts[r]; k += 4) theirs.insert({all[k], all[k + 1], all[k + 2], all[k + 3]});
+    for (int k = displs[r]; k + 3 < displs[r] + counts[r]; k += 4)
+      theirs.insert({all[k], all[k + 1], all[k + 2], all[k + 3]});
     if (theirs.empty()) continue;
     for (std::size_t b = 0; b < share.size(); ++b) {
       const BlockShare& s = share[b];
@@ -121,7 +122,8 @@ std::vector<double> best_on_root(MPI_Comm comm, const std::vector<double>& candi
     const double v = all[k], key = all[k + 1];
     if (std::isnan(v)) continue;
     if (std::isnan(best[5 * b]) || v > best[5 * b] || (v == best[5 * b] && key < best[5 * b + 1]))
-      std::copy(all.begin() + std::ptrdiff_t(k), all.begin() + std::ptrdiff_t(k + 5), best.begin() + std::ptrdiff_t(5 * b));
+      std::copy(all.begin() + std::ptrdiff_t(k), all.begin() + std::ptrdiff_t(k + 5),
+                best.begin() + std::ptrdiff_t(5 * b));
   }
   return best;
 }
@@ -213,7 +215,8 @@ std::vector<ElementStressSummary> element_stress_summary(MPI_Comm comm, const So
       const Vec3d& c = s.centres[m.centre];
       averaged_max.insert(averaged_max.end(), {m.value, s.keys[m.centre], c(0), c(1), c(2)});
     }
-    for (std::size_t k = 0; k < s.values.size(); ++k) percentile.insert(percentile.end(), {double(b), s.values[k], s.volumes[k]});
+    for (std::size_t k = 0; k < s.values.size(); ++k)
+      percentile.insert(percentile.end(), {double(b), s.values[k], s.volumes[k]});
   }
   share.clear();
   const std::vector<double> best = best_on_root(comm, element_max, nb);

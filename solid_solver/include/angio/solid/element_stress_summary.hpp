@@ -13,9 +13,9 @@ namespace angio::solid {
 class SolidModel;
 
 struct ElementStressSummary {
-  double max = -std::numeric_limits<double>::infinity();  // max over the block's elements (-inf: none)
-  Vec3d where = Vec3d::Zero();                              // current centroid of that element
-  double p99 = 0.0;                                         // 99th percentile by reference volume
+  double max = -std::numeric_limits<double>::infinity();           // max over the block's elements (-inf: none)
+  Vec3d where = Vec3d::Zero();                                     // current centroid of that element
+  double p99 = 0.0;                                                // 99th percentile by reference volume
   double max_averaged = std::numeric_limits<double>::quiet_NaN();  // max of the ball average (NaN: none)
   Vec3d where_averaged = Vec3d::Zero();                            // the centre of that ball
 };
