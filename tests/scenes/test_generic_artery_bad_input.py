@@ -140,26 +140,21 @@ CASES = [
     ),
 ]
 
+
+def launch(scene, *args):
+    """launch.py on `scene` with the build of BIN_DIR."""
+    cmd = [sys.executable, str(ROOT / "scripts" / "launch.py"), str(scene), *args]
+    cmd += ["--build-dir", str(Path(sys.argv[1]).parent)]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     for name, edit, key in CASES:
         s = yaml.safe_load(SCENE.read_text())
         edit(s)
         scene = Path(tmp) / "bad.yaml"
         scene.write_text(yaml.safe_dump(s, sort_keys=False))
-        r = subprocess.run(
-            [
-                sys.executable,
-                str(ROOT / "scripts" / "launch.py"),
-                str(scene),
-                "--run-dir",
-                str(Path(tmp) / name.replace(" ", "_")),
-                "--build-dir",
-                str(Path(sys.argv[1]).parent),
-            ],
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
+        r = launch(scene, "--run-dir", str(Path(tmp) / name.replace(" ", "_")))
         out = r.stdout + r.stderr
         # the executables check the scene (--check) before the launcher creates the run directory
         left = (Path(tmp) / name.replace(" ", "_")).exists()
@@ -177,19 +172,7 @@ with tempfile.TemporaryDirectory() as tmp:
     s["solid"]["petsc_options"] += TELESCOPE.format(factor=2)
     scene = Path(tmp) / "telescope.yaml"
     scene.write_text(yaml.safe_dump(s, sort_keys=False))
-    r = subprocess.run(
-        [
-            sys.executable,
-            str(ROOT / "scripts" / "launch.py"),
-            str(scene),
-            "--check",
-            "--build-dir",
-            str(Path(sys.argv[1]).parent),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    r = launch(scene, "--check")
     ok = r.returncode == 0 and "the scene is valid" in r.stdout
     print(("ok   " if ok else "FAIL ") + f"telescope onto 1 of the 2 ranks accepted: exit {r.returncode}", flush=True)
     if not ok:
