@@ -189,10 +189,7 @@ def check_scene_with(name, exe, scene_path):
         die(f"cannot check the scene with {name}: {e}", code=1)
     if r.returncode == 0:
         return
-    lines = [ln for ln in (r.stderr + r.stdout).splitlines() if ln.strip()]
-    # the executable's own error line; under mpirun its banner about the exit code comes after it
-    own = [ln for ln in lines if re.match(r"^\[[a-z_]+\] ERROR: ", ln.strip())]
-    msg = (own or lines or [""])[-1]
+    msg = next((ln for ln in reversed((r.stderr + r.stdout).splitlines()) if ln.strip()), "")
     msg = re.sub(r"^\[[a-z_]+\] (ERROR: )?", "", msg.strip())
     if r.returncode == 2:
         die(msg or f"{name} refused the scene")
@@ -830,8 +827,7 @@ def main():
     check_path = scene_path if prepared is None else scratch_scene(prepared)
     checks = [
         ("beam_solver", beam_exe if has_stent and not args.beam_cmd else None),
-        # on its ranks: options that depend on their number (a PCTELESCOPE reduction) are tried as they will run
-        ("solid_solver", mpirun + [find_binary(build, "solid_solver")] if has_solid and not args.solid_cmd else None),
+        ("solid_solver", [find_binary(build, "solid_solver")] if has_solid and not args.solid_cmd else None),
         ("coupler", coupler_exe),
     ]
     for name, exe in checks:

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <map>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 #include <unordered_set>
 
 #include "angio/solid/artery_measures.hpp"
@@ -31,8 +33,7 @@ struct BlockShare {
   Vec3d best_where = Vec3d::Zero();
 };
 
-// A cell of the grid of spacing h (the ball's radius) within one block: a point within h of a
-// centre lies in the centre's cell or one of its 26 neighbours.
+// A cell of the grid of spacing h within one block.
 struct Cell {
   std::int64_t b, i, j, k;
   bool operator==(const Cell& o) const { return b == o.b && i == o.i && j == o.j && k == o.k; }
@@ -51,17 +52,20 @@ Cell cell_of(std::int64_t b, const Vec3d& x, double h) {
           std::int64_t(std::floor(x(2) / h))};
 }
 
-// The other ranks' Gauss points near this rank's centres, appended to `share`. Collective.
-void exchange_points(MPI_Comm comm, std::vector<BlockShare>& share, double radius) {
+// The other ranks' Gauss points near this rank's centres, appended to `share`: every point within h
+// of a centre lies in the centre's cell of spacing h or in one of its 26 neighbours (h at least the
+// ball's radius, so all points a ball needs arrive, and some more). Collective.
+void exchange_points(MPI_Comm comm, std::vector<BlockShare>& share, double h) {
   int size = 1, rank = 0;
   MPI_Comm_size(comm, &size);
   MPI_Comm_rank(comm, &rank);
   if (size == 1) return;
   // this rank's cells next to a centre (its centres' cells dilated by one), as (block, i, j, k), to
-  // every rank
+  // every rank; a non-finite position lies in no ball
   std::unordered_set<Cell, CellHash> own, near;
   for (std::size_t b = 0; b < share.size(); ++b)
-    for (const Vec3d& c : share[b].centres) own.insert(cell_of(std::int64_t(b), c, radius));
+    for (const Vec3d& c : share[b].centres)
+      if (c.allFinite()) own.insert(cell_of(std::int64_t(b), c, h));
   for (const Cell& m : own)
     for (int di = -1; di <= 1; ++di)
       for (int dj = -1; dj <= 1; ++dj)
@@ -86,7 +90,7 @@ void exchange_points(MPI_Comm comm, std::vector<BlockShare>& share, double radiu
     for (std::size_t b = 0; b < share.size(); ++b) {
       const BlockShare& s = share[b];
       for (std::size_t q = 0; q < s.points.size(); ++q)
-        if (theirs.count(cell_of(std::int64_t(b), s.points[q], radius)))
+        if (s.points[q].allFinite() && theirs.count(cell_of(std::int64_t(b), s.points[q], h)))
           out[std::size_t(r)].insert(out[std::size_t(r)].end(), {double(b), s.points[q](0), s.points[q](1),
                                                                  s.points[q](2), s.point_value[q], s.point_weight[q]});
     }
@@ -133,10 +137,16 @@ std::vector<double> best_on_root(MPI_Comm comm, const std::vector<double>& candi
 std::vector<ElementStressSummary> element_stress_summary(MPI_Comm comm, const SolidModel& model,
                                                          const std::vector<double>& p1, const std::vector<double>& vol,
                                                          double radius) {
+  // the same on every rank (the scene's key): refused before any collective call
+  if (!(std::isfinite(radius) && radius > 0.0))
+    throw std::invalid_argument("element stress summary: ball radius must be positive and finite, got " +
+                                std::to_string(radius));
+  const auto& le = model.local_elements();
+  if (p1.size() != le.size() || vol.size() != le.size())
+    throw std::invalid_argument("element stress summary: one p1 and one volume per local element expected");
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   const Mesh& mesh = model.mesh();
-  const auto& le = model.local_elements();
   const std::size_t nb = mesh.blocks.size();
   std::vector<BlockShare> share(nb);
   // shape functions at the Gauss points and their volume shares w_q / Σw, once per element type
@@ -156,7 +166,8 @@ std::vector<ElementStressSummary> element_stress_summary(MPI_Comm comm, const So
     }
     return it->second;
   };
-  // elements by index, so that the first of equal centres is the one of the lowest key
+  // elements by index (local_elements() is ascending today; sorted here so that the tie rule, the
+  // first of equal centres is the one of the lowest key, does not depend on it)
   std::vector<std::size_t> order(le.size());
   std::iota(order.begin(), order.end(), std::size_t(0));
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return le[a] < le[b]; });
@@ -200,7 +211,14 @@ std::vector<ElementStressSummary> element_stress_summary(MPI_Comm comm, const So
       share[b].keys.push_back(ne + double(n));
     }
   }
-  exchange_points(comm, share, radius);
+  // cells at least the ball's radius (a hair more, so that rounding in x / h cannot put a point
+  // within the radius two cells away) and at least the mean element's size (a radius far below the
+  // elements would otherwise make every rank send cells by the million)
+  double volume_count[2] = {0.0, double(le.size())};
+  for (double v : vol) volume_count[0] += v;
+  MPI_Allreduce(MPI_IN_PLACE, volume_count, 2, MPI_DOUBLE, MPI_SUM, comm);
+  const double element_size = volume_count[1] > 0.0 ? std::cbrt(volume_count[0] / volume_count[1]) : 0.0;
+  exchange_points(comm, share, std::max(radius * (1.0 + 1e-6), element_size));
 
   std::vector<double> element_max, averaged_max, percentile;
   for (std::size_t b = 0; b < nb; ++b) {

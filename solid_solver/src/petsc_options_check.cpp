@@ -43,8 +43,7 @@ std::vector<std::string> unused_petsc_options(PetscOptions o, const std::string&
   return unused;
 }
 
-PetscOptionsCheck check_petsc_options(const std::string& options, const std::vector<std::string>& parts,
-                                      MPI_Comm comm) {
+PetscOptionsCheck check_petsc_options(const std::string& options, const std::vector<std::string>& parts) {
   PetscOptionsCheck out;
   std::string message;
   PetscOptions o = nullptr;
@@ -59,22 +58,19 @@ PetscOptionsCheck check_petsc_options(const std::string& options, const std::vec
     PetscCall(PetscOptionsInsertString(o, options.c_str()));
     PetscCall(PetscOptionsPush(o));
     pushed = true;
-    // the 1D Laplacian (tridiagonal, SPD) on two unknowns per part and rank
-    PetscMPIInt ranks = 1, rank = 0;
-    PetscCallMPI(MPI_Comm_size(comm, &ranks));
-    PetscCallMPI(MPI_Comm_rank(comm, &rank));
-    const PetscInt n = 2 * PetscInt(std::max<std::size_t>(parts.size(), 1)), N = n * ranks, first = n * rank;
-    PetscCall(MatCreateAIJ(comm, n, n, N, N, 3, nullptr, 2, nullptr, &A));
-    for (PetscInt i = first; i < first + n; ++i) {
+    // the 1D Laplacian (tridiagonal, SPD) on two unknowns per part
+    const PetscInt n = 2 * PetscInt(std::max<std::size_t>(parts.size(), 1));
+    PetscCall(MatCreateSeqAIJ(PETSC_COMM_SELF, n, n, 3, nullptr, &A));
+    for (PetscInt i = 0; i < n; ++i) {
       PetscCall(MatSetValue(A, i, i, 2.0, INSERT_VALUES));
       if (i > 0) PetscCall(MatSetValue(A, i, i - 1, -1.0, INSERT_VALUES));
-      if (i + 1 < N) PetscCall(MatSetValue(A, i, i + 1, -1.0, INSERT_VALUES));
+      if (i + 1 < n) PetscCall(MatSetValue(A, i, i + 1, -1.0, INSERT_VALUES));
     }
     PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatCreateVecs(A, &x, &b));
     PetscCall(VecSet(b, 1.0));
-    PetscCall(KSPCreate(comm, &ksp));
+    PetscCall(KSPCreate(PETSC_COMM_SELF, &ksp));
     PetscCall(KSPSetOperators(ksp, A, A));
     PetscCall(KSPSetFromOptions(ksp));
     PC pc;
@@ -83,7 +79,7 @@ PetscOptionsCheck check_petsc_options(const std::string& options, const std::vec
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &split));
     for (std::size_t k = 0; split && k < parts.size(); ++k) {
       IS is;
-      PetscCall(ISCreateStride(comm, 2, first + 2 * PetscInt(k), 1, &is));
+      PetscCall(ISCreateStride(PETSC_COMM_SELF, 2, 2 * PetscInt(k), 1, &is));
       PetscCall(PCFieldSplitSetIS(pc, parts[k].c_str(), is));
       PetscCall(ISDestroy(&is));
     }

@@ -5,6 +5,7 @@
 #include <mpi.h>
 #include <petscsys.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -40,14 +41,15 @@ void all_elements(const SolidModel& model, const std::vector<double>& p1, const 
 
 }  // namespace
 
-// A stress field peaked at the cube's centre, averaged over balls (radius 0.3 on a unit cube of
-// 4 × 4 × 4 elements) that reach across any cut of the cube into two: each rank's maximum ball needs
-// the other rank's Gauss points near it. The reference takes every element's Gauss points and centres
+// A stress field peaked at the cube's centre (the origin: the cube spans −0.5..0.5), averaged over
+// balls (radius 0.3, 4 × 4 × 4 elements) that reach across a cut of the cube into two: the maximum's
+// ball needs the other rank's Gauss points (asserted). The reference takes every element's Gauss points and centres
 // (their centroids, then every node) at once, as the summary did on rank 0 before.
 TEST(ElementStressSummary, EqualsTheSummaryOfAllElementsOnAnyPartition) {
   const double radius = 0.3;
   for (ElemType t : {ElemType::Hex8, ElemType::Tet10}) {
-    const Mesh m = angio_test::cube_mesh(t, 4, 0.08, 3);
+    Mesh m = angio_test::cube_mesh(t, 4, 0.08, 3);
+    for (auto& X : m.X) X -= Vec3d(0.5, 0.5, 0.5);  // negative coordinates: cells below zero
     ModelOptions o;
     o.partitioner = "ptscotch";
     SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {1.0, 0.3}, {}}}, o);
@@ -64,19 +66,26 @@ TEST(ElementStressSummary, EqualsTheSummaryOfAllElementsOnAnyPartition) {
       return Vec3d(c / double(m.elements[std::size_t(e)].nn()));
     };
     for (std::size_t i = 0; i < le.size(); ++i)
-      p1[i] = std::exp(-(centroid(le[i]) - Vec3d(0.5, 0.5, 0.5)).squaredNorm() / 0.05) + 0.01 * double(le[i] % 7);
+      p1[i] = std::exp(-centroid(le[i]).squaredNorm() / 0.05) + 0.01 * double(le[i] % 7);
 
     const std::vector<ElementStressSummary> s = element_stress_summary(PETSC_COMM_WORLD, model, p1, vol, radius);
     ASSERT_EQ(s.size(), 1u);
-    std::vector<double> all_p1, all_vol;
+    std::vector<double> all_p1, all_vol, owner;
     all_elements(model, p1, vol, all_p1, all_vol);
+    {  // each element's rank, to see that the maximum's ball needs another rank's points
+      int me = 0;
+      MPI_Comm_rank(PETSC_COMM_WORLD, &me);
+      std::vector<double> mine(le.size(), double(me));
+      std::vector<double> unused;
+      all_elements(model, mine, vol, owner, unused);
+    }
     int rank = 0;
     MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
     if (rank != 0) continue;
 
     // the reference: every element at once
     std::vector<Vec3d> centres, points;
-    std::vector<double> point_value, point_weight;
+    std::vector<double> point_value, point_weight, point_owner;
     double best = -std::numeric_limits<double>::infinity();
     Vec3d where = Vec3d::Zero();
     for (std::size_t e = 0; e < m.elements.size(); ++e) {
@@ -96,6 +105,7 @@ TEST(ElementStressSummary, EqualsTheSummaryOfAllElementsOnAnyPartition) {
         Vec3d x = Vec3d::Zero();
         for (int a = 0; a < el.nn(); ++a) x += N(a) * model.position(el.n[a]);
         points.push_back(x);
+        point_owner.push_back(owner[e]);
         point_value.push_back(all_p1[e]);
         point_weight.push_back(all_vol[e] * q.w / wsum);
       }
@@ -103,6 +113,14 @@ TEST(ElementStressSummary, EqualsTheSummaryOfAllElementsOnAnyPartition) {
     for (std::size_t n = 0; n < m.X.size(); ++n) centres.push_back(model.position(int(n)));
     const BallMaximum ref = max_ball_average(centres, points, point_value, point_weight, radius);
     ASSERT_NE(ref.centre, BallMaximum::none);
+    int size = 1;
+    MPI_Comm_size(PETSC_COMM_WORLD, &size);
+    if (size > 1) {  // else the test could not tell a missing exchange
+      std::vector<char> seen(std::size_t(size), 0);
+      for (std::size_t q = 0; q < points.size(); ++q)
+        if ((points[q] - centres[ref.centre]).norm() <= radius) seen[std::size_t(point_owner[q])] = 1;
+      EXPECT_GT(std::count(seen.begin(), seen.end(), 1), 1) << "the maximum's ball lies on one rank";
+    }
 
     EXPECT_EQ(s[0].max, best);
     EXPECT_EQ((s[0].where - where).norm(), 0.0);

@@ -25,12 +25,13 @@ struct ElementStressSummary {
 // Collective.
 //
 // Each rank averages over the balls centred on its own elements' centroids and nodes, with its own
-// elements' Gauss points and those of other ranks' elements that lie in a cell (of the ball's radius)
-// next to one of its centres: exactly the points within the radius of them. Gathering the blocks' Gauss
+// elements' Gauss points and those of other ranks' elements that lie in a cell (at least the ball's
+// radius wide) next to one of its centres: every point within the radius of them. Gathering the blocks' Gauss
 // points on rank 0 instead held 67 MB there for the 0.25 mm patient artery (heaptrack, 8 ranks;
 // docs/performance.md "What a rank holds at 8 ranks"). Ties between centres go to the element, then the
-// node, of the lowest index, whatever the partition. The percentile gathers (value, volume) per element
-// on rank 0 (16 bytes each).
+// node, of the lowest index, whatever the partition. The percentile gathers (block, value, volume) per
+// element on rank 0 (24 bytes each). radius not positive and finite, or p1 / vol not one per local
+// element: invalid_argument, on every rank alike.
 std::vector<ElementStressSummary> element_stress_summary(MPI_Comm comm, const SolidModel& model,
                                                          const std::vector<double>& p1, const std::vector<double>& vol,
                                                          double radius);

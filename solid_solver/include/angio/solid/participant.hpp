@@ -49,7 +49,7 @@ struct BlockStress {
   // max over the block of the element stress averaged over a ball of radius stress_average_radius
   // (stress_average.hpp: the measure that converges under refinement at a strut), rank 0 only; NaN: none
   double max_averaged = std::numeric_limits<double>::quiet_NaN();
-  Vec3d where_averaged = Vec3d::Zero();  // current centroid of the element whose ball holds it
+  Vec3d where_averaged = Vec3d::Zero();  // the centre of that ball (an element's centroid or a node, current)
   // The recovered nodal first principal stress of the block (stress_recovery.hpp: L2 projection onto
   // the block's own nodes, a layer interface node has one value per layer), rank 0 only; NaN: none.
   double max_nodal = std::numeric_limits<double>::quiet_NaN();  // max over the block's nodes (MPa)

@@ -17,14 +17,12 @@ struct PetscOptionsCheck {
   bool fieldsplit = false;          // they select -pc_type fieldsplit (one split per part)
 };
 
-// Sets up and runs a KSP with petsc_default_options() and then `options` on a small system over
-// `comm` (PETSc initialized; collective), two unknowns per name of `parts` (the mesh's parts,
-// Block::part) on each rank: with -pc_type fieldsplit each part is a split named after it, as
-// SolidModel defines them, so that the options of each split (-fieldsplit_artery_pc_type ...) are
-// tried too. On the run's own communicator, options that depend on the number of ranks (a
-// PCTELESCOPE reduction factor) are tried as they will run. Never throws for a refused option.
-PetscOptionsCheck check_petsc_options(const std::string& options, const std::vector<std::string>& parts = {},
-                                      MPI_Comm comm = PETSC_COMM_SELF);
+// Sets up and runs a KSP with petsc_default_options() and then `options` on a small system (this
+// rank only, PETSC_COMM_SELF; PETSc initialized), two unknowns per name of `parts` (the mesh's parts,
+// Block::part): with -pc_type fieldsplit each part is a split named after it, as SolidModel defines
+// them, so that the options of each split (-fieldsplit_artery_pc_type ...) are tried too. Never throws
+// for a refused option.
+PetscOptionsCheck check_petsc_options(const std::string& options, const std::vector<std::string>& parts = {});
 
 // The options named in `options` that nothing has queried from the database `o` (null: none).
 std::vector<std::string> unused_petsc_options(PetscOptions o, const std::string& options);
