@@ -15,7 +15,6 @@
 #include <petsclog.h>
 
 #include "angio/common/log.hpp"
-#include "angio/solid/element_stress_summary.hpp"
 #include "angio/solid/gather.hpp"
 #include "petsc_check.hpp"
 
@@ -287,13 +286,7 @@ void SolidRunner::block_stress_(const std::vector<double>& p1, const std::vector
   const std::vector<ElementStressSummary> e =
       element_stress_summary(comm_, *model_, p1, vol, scene_.stress_average_radius);
   s.stress.assign(e.size(), BlockStress{});
-  if (rank_ != 0) return;
-  for (size_t b = 0; b < e.size(); ++b) {
-    s.stress[b].where = e[b].where;
-    s.stress[b].p99 = e[b].p99;
-    s.stress[b].max_averaged = e[b].max_averaged;
-    s.stress[b].where_averaged = e[b].where_averaged;
-  }
+  for (size_t b = 0; b < e.size(); ++b) static_cast<ElementStressSummary&>(s.stress[b]) = e[b];
 }
 
 void SolidRunner::nodal_stress_(StepSummary& s) const {

@@ -13,11 +13,14 @@ namespace angio::solid {
 class SolidModel;
 
 struct ElementStressSummary {
-  double max = -std::numeric_limits<double>::infinity();           // max over the block's elements (-inf: none)
-  Vec3d where = Vec3d::Zero();                                     // current centroid of that element
-  double p99 = 0.0;                                                // 99th percentile by reference volume
-  double max_averaged = std::numeric_limits<double>::quiet_NaN();  // max of the ball average (NaN: none)
-  Vec3d where_averaged = Vec3d::Zero();                            // the centre of that ball
+  double max = -std::numeric_limits<double>::infinity();  // max over the block's elements (-inf: none)
+  Vec3d where = Vec3d::Zero();                            // current centroid of that element
+  // 99th percentile by reference volume (MPa), robust against one element at a strut
+  double p99 = 0.0;
+  // max of the element stress averaged over a ball of the scene's stress_average_radius: the measure
+  // that converges under refinement at a strut (stress_average.hpp); NaN: none
+  double max_averaged = std::numeric_limits<double>::quiet_NaN();
+  Vec3d where_averaged = Vec3d::Zero();  // the centre of that ball (an element's centroid or a node, current)
 };
 
 // For every block of the model's mesh, from p1 and vol (per local element, the model's local_elements()

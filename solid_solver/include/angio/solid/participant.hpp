@@ -13,6 +13,7 @@
 
 #include "angio/participant/solid_participant.hpp"
 #include "angio/solid/artery_measures.hpp"
+#include "angio/solid/element_stress_summary.hpp"
 #include "angio/solid/output.hpp"
 #include "angio/solid/scene.hpp"
 #include "angio/solid/stress_recovery.hpp"
@@ -41,15 +42,10 @@ class StentContact : public ContactModel {
 void reset_reply(const participant::SamplePoints& points, participant::ContactReply& reply);
 
 // First principal Cauchy stress of one block (layer) at one step (per element: the eigenvalue of
-// the Gauss-point averaged Cauchy tensor).
+// the Gauss-point averaged Cauchy tensor): the element measures (element_stress_summary.hpp: where
+// the maximum is, p99, the ball-averaged maximum; rank 0 only) and the recovered nodal ones.
 // (The maximum itself is StepSummary::max_p1, known on every rank.)
-struct BlockStress {
-  Vec3d where = Vec3d::Zero();  // current centroid of the element with the maximum
-  double p99 = 0.0;             // 99th percentile by reference volume (MPa), robust against one element at a strut
-  // max over the block of the element stress averaged over a ball of radius stress_average_radius
-  // (stress_average.hpp: the measure that converges under refinement at a strut), rank 0 only; NaN: none
-  double max_averaged = std::numeric_limits<double>::quiet_NaN();
-  Vec3d where_averaged = Vec3d::Zero();  // the centre of that ball (an element's centroid or a node, current)
+struct BlockStress : ElementStressSummary {
   // The recovered nodal first principal stress of the block (stress_recovery.hpp: L2 projection onto
   // the block's own nodes, a layer interface node has one value per layer), rank 0 only; NaN: none.
   double max_nodal = std::numeric_limits<double>::quiet_NaN();  // max over the block's nodes (MPa)
