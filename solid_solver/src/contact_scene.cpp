@@ -86,6 +86,7 @@ ContactSpec read_contact_spec(const Node& root) {
   const std::string line_tangent = c->get<std::string>("line_tangent");
   spec.line_ring_tangent = line_tangent == "ring";
   spec.line_force_tangent = line_tangent != "gap";
+  spec.line_definite_force_terms = line_tangent == "definite";
   spec.log = c->get<bool>("log");
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);
@@ -129,6 +130,7 @@ ContactSetup::ContactSetup(SolidRunner& runner, const ContactSpec& spec) : runne
   so.averaged_normals = spec.line_averaged_normals;
   so.ring_tangent = spec.line_ring_tangent;
   so.force_tangent = spec.line_force_tangent;
+  so.definite_force_terms = spec.line_definite_force_terms;
   if (has_balloon) so.balloon_penalty = spec.stent_balloon;
   if (has_artery) so.artery_penalty = spec.stent_artery;
   so.balloon_from = spec.stent_balloon_from;

@@ -154,6 +154,7 @@ std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const Sol
     par.averaged_normals = opt_.averaged_normals;
     par.ring_tangent = opt_.ring_tangent;
     par.force_tangent = opt_.force_tangent;
+    par.definite_force_terms = opt_.definite_force_terms;
     par.compute_tangent = tangent;
     const std::span<contact::ProjectionHint> hint[] = {std::span(hints_[k]).subspan(first, points.size())};
     per_surface.push_back(contact::evaluate_line_contact(points, one, par, hint));

@@ -1,6 +1,7 @@
 // Line contact along the averaged nodal normal field (normal_field.hpp, LineContactParams::averaged_normals).
 #include <algorithm>
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include "angio/participant/penalty_law.hpp"
@@ -241,6 +242,31 @@ TEST(NormalField, FaceTangentIsTheRingTangentsFaceColumns) {
   }
 }
 
+// The helix's points against a perturbed quarter cylinder of one face kind, searched along the averaged normal
+// field or for the closest point; eval() with the face's columns only (ring_tangent = false) and penalty 10.
+struct HelixOnQuarterCylinder {
+  test::Mesh m;
+  std::vector<BeamPoint> pts;
+  SurfaceSearch S;
+  bool averaged;
+  HelixOnQuarterCylinder(FaceKind kind, bool averaged_normals)
+      : m(perturbed_quarter_cylinder(kind, 5)), pts(helix_points()), S(m.surface, 0.3), averaged(averaged_normals) {
+    if (averaged) S.enable_normal_field();
+    S.update(m.x);
+  }
+  LineContactResult eval(double g0, bool force, bool definite = false) const {
+    LineContactParams par;
+    par.penalty = 10.0;
+    par.averaged_normals = averaged;
+    par.ring_tangent = false;
+    par.regularization = g0;
+    par.force_tangent = force;
+    par.definite_force_terms = definite;
+    const SurfaceSearch* s[] = {&S};
+    return evaluate_line_contact(pts, s, par);
+  }
+};
+
 // Compares against: the exact tangent, which is affine in the penalty law's force f and stiffness k for one
 // configuration. In the law's linear range (g <= 0) k = eps whatever the regularization g0, while f = eps (g0/2
 // - g) moves with g0; so with LineContactParams::force_tangent = false (contact.line_tangent: gap) the tangent
@@ -249,21 +275,8 @@ TEST(NormalField, FaceTangentIsTheRingTangentsFaceColumns) {
 TEST(NormalField, GapTangentLeavesOutExactlyTheForceTerms) {
   for (bool averaged : {true, false})
     for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
-      const test::Mesh m = perturbed_quarter_cylinder(kind, 5);
-      const std::vector<BeamPoint> pts = helix_points();
-      SurfaceSearch S(m.surface, 0.3);
-      if (averaged) S.enable_normal_field();
-      S.update(m.x);
-      const SurfaceSearch* s[] = {&S};
-      auto eval = [&](double g0, bool force) {
-        LineContactParams par;
-        par.penalty = 10.0;
-        par.averaged_normals = averaged;
-        par.ring_tangent = false;
-        par.regularization = g0;
-        par.force_tangent = force;
-        return evaluate_line_contact(pts, s, par);
-      };
+      const HelixOnQuarterCylinder h(kind, averaged);
+      auto eval = [&](double g0, bool force) { return h.eval(g0, force); };
       const double g1 = 0.002, g2 = 0.01;  // both below the points' penetration (about 0.02 mm): linear range
       const LineContactResult e1 = eval(g1, true), e2 = eval(g2, true), p1 = eval(g1, false), p2 = eval(g2, false);
       ASSERT_EQ(e1.solid.size(), 12u);
@@ -284,6 +297,44 @@ TEST(NormalField, GapTangentLeavesOutExactlyTheForceTerms) {
         EXPECT_GT(B1.norm(), 1e-3 * K.norm() / f1) << name(kind);  // the force's terms are there to leave out
         EXPECT_LT((B1 - B2).norm(), 1e-9 * B1.norm()) << name(kind) << " averaged " << averaged;
       }
+    }
+}
+
+// Compares against: the definition of the projection onto the positive semidefinite cone. With
+// LineContactParams::definite_force_terms (contact.line_tangent: definite) the tangent is K_gap + P, P the
+// positive semidefinite part of the symmetric part S of the force's terms K_f = K_exact - K_gap (face columns).
+// P is that projection exactly when P >= 0, P - S >= 0 and P (P - S) = 0 (the two parts' eigenvectors split the
+// space). The residual is the exact one's; where S has negative eigenvalues (checked: the case the option is for)
+// P differs from S. For the averaged-normal kernel and the closest-point kernel.
+TEST(NormalField, DefiniteTangentKeepsThePositivePartOfTheForceTerms) {
+  for (bool averaged : {true, false})
+    for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
+      const HelixOnQuarterCylinder h(kind, averaged);  // face columns: the definite tangent has no others
+      const LineContactResult exact = h.eval(0.005, true), gap = h.eval(0.005, false), def = h.eval(0.005, true, true);
+      ASSERT_EQ(def.solid.size(), 12u);
+      int indefinite = 0;
+      for (std::size_t i = 0; i < def.solid.size(); ++i) {
+        const NodalContribution &d = def.solid[i], &g = gap.solid[i], &e = exact.solid[i];
+        EXPECT_EQ(d.r, e.r) << name(kind);
+        EXPECT_EQ(d.nodes, g.nodes) << name(kind);
+        ASSERT_EQ(d.K.rows(), d.K.cols()) << name(kind);
+        const Eigen::MatrixXd Kf = e.K - g.K;
+        const Eigen::MatrixXd Sf = 0.5 * (Kf + Kf.transpose());
+        const Eigen::MatrixXd P = d.K - g.K;
+        const double scale = Sf.norm();
+        ASSERT_GT(scale, 0.0);
+        EXPECT_LT((P - P.transpose()).norm(), 1e-12 * scale) << name(kind);
+        const Eigen::MatrixXd Psym = 0.5 * (P + P.transpose());
+        const Eigen::MatrixXd Q = 0.5 * ((P - Sf) + (P - Sf).transpose());
+        EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Psym).eigenvalues().minCoeff(), -1e-12 * scale);
+        EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Q).eigenvalues().minCoeff(), -1e-12 * scale);
+        EXPECT_LT((P * (P - Sf)).norm(), 1e-12 * scale * scale) << name(kind);
+        if (Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Sf).eigenvalues().minCoeff() < -1e-6 * scale) {
+          ++indefinite;
+          EXPECT_GT((P - Sf).norm(), 1e-6 * scale) << name(kind);
+        }
+      }
+      EXPECT_GT(indefinite, 0) << name(kind) << " averaged " << averaged;  // the case the option is for
     }
 }
 

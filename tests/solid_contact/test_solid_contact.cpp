@@ -215,8 +215,9 @@ TEST(StentContact, RunnerRingOfPointsConverges) {
 // (1c) Consistency of contact.line_tangent: the face tangent (default) leaves out columns of the averaged
 // normals' exact tangent but not of the residual, so a Newton with it converges to the state of a Newton
 // with the exact (ring) tangent: the same ring of points pressing the balloon gives the same line loads to
-// the Newton tolerance, the face tangent in no fewer iterations (it is not exact); so does the gap tangent,
-// which also leaves out the terms of the force's magnitude.
+// the Newton tolerance, the face tangent in no fewer iterations (it is not exact); so do the gap tangent,
+// which also leaves out the terms of the force's magnitude, and the definite tangent, which keeps their
+// positive semidefinite part.
 TEST(StentContact, FaceTangentConvergesToTheRingTangentsState) {
   auto solve = [](const char* tangent, int& iterations) {
     const std::string keys = std::string("  line_normals: averaged\n  line_tangent: ") + tangent + "\n";
@@ -235,7 +236,8 @@ TEST(StentContact, FaceTangentConvergesToTheRingTangentsState) {
   };
   int it_ring = 0;
   const auto ring = solve("ring", it_ring);
-  for (const char* other : {"face", "gap"}) {  // gap: also without the force's terms (contact.line_tangent)
+  // gap: also without the force's terms; definite: with their positive semidefinite part only
+  for (const char* other : {"face", "gap", "definite"}) {
     int it = 0;
     const auto loads = solve(other, it);
     ASSERT_EQ(ring.size(), loads.size());
@@ -675,6 +677,10 @@ TEST(ContactScene, ReadsAndValidates) {
   EXPECT_TRUE(read_contact_spec(node("time: {end: 1}")).line_force_tangent);
   EXPECT_FALSE(read_contact_spec(node("contact: {line_tangent: gap}")).line_force_tangent);
   EXPECT_FALSE(read_contact_spec(node("contact: {line_tangent: gap}")).line_ring_tangent);
+  EXPECT_FALSE(read_contact_spec(node("contact: {line_tangent: gap}")).line_definite_force_terms);
+  const ContactSpec definite = read_contact_spec(node("contact: {line_tangent: definite}"));
+  EXPECT_TRUE(definite.line_force_tangent && definite.line_definite_force_terms);
+  EXPECT_FALSE(definite.line_ring_tangent);
 }
 
 // The shipped scene parses (solid parts + contact section) and enables balloon-artery contact.

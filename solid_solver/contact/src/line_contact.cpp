@@ -5,6 +5,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
+
 #include "angio/participant/penalty_law.hpp"
 
 namespace angio::contact {
@@ -38,6 +40,19 @@ std::optional<PenaltyLaw> start_point(const BeamPoint& bp, double d, int nn, int
   pc.energy = bp.w * law.pi;
   return law;
 }
+
+// A += P+((B + B^T)/2), B square over the face's nodes: the positive semidefinite part of B's symmetric part
+// (LineContactParams::definite_force_terms). Fixed-capacity storage: no allocation per contact point.
+using FaceSquare =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 3 * kMaxFaceNodes, 3 * kMaxFaceNodes>;
+void add_definite_part(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Eigen::MatrixXd> A) {
+  const FaceSquare S = 0.5 * (B + B.transpose());
+  const Eigen::SelfAdjointEigenSolver<FaceSquare> eig(S);
+  const auto& lambda = eig.eigenvalues();
+  const auto& V = eig.eigenvectors();
+  for (Eigen::Index j = 0; j < lambda.size(); ++j)
+    if (lambda(j) > 0.0) A.noalias() += lambda(j) * V.col(j) * V.col(j).transpose();
+}
 }  // namespace
 
 void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, double normal_sign, const Projection& proj,
@@ -58,7 +73,12 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
   if (K) {
     const Eigen::RowVectorXd dX = L.dd.segment(3, m - 3);
     *K = w * k * dX.transpose() * dX;
-    if (par.force_tangent) *K -= w * f * L.hd.bottomRightCorner(m - 3, m - 3);
+    if (par.force_tangent && par.definite_force_terms) {
+      const FaceSquare Kf = -w * f * L.hd.bottomRightCorner(m - 3, m - 3);  // symmetric: the Hessian of d
+      add_definite_part(Kf, *K);
+    } else if (par.force_tangent) {
+      *K -= w * f * L.hd.bottomRightCorner(m - 3, m - 3);
+    }
   }
   if (par.beam_tangent) {
     // q = f n: dq/dx = −k n dd_x + f dn_x
@@ -68,7 +88,7 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
 
 void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX& X, const FaceX& Nn,
                                 const NormalFieldProjection& proj, const LineContactParams& par, PointContact& pc,
-                                Eigen::VectorXd& r, Eigen::MatrixXd* K) {
+                                Eigen::VectorXd& r, Eigen::MatrixXd* K, Eigen::MatrixXd* Kf) {
   const int nn = num_nodes(kind);
   pc.proj = Projection{};
   pc.proj.valid = proj.valid;
@@ -91,12 +111,16 @@ void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX&
   // r_a = w f nu N_a (= minus the force on face node a); f = f(g), df = −k dg
   for (int a = 0; a < nn; ++a) r.segment<3>(3 * a) = w * f * L.N[a] * proj.nu;
   if (K) {
-    // d(f nu)/du, 3 x m; without the force's terms (force_tangent) only the gap's stiffness
-    const double fk = par.force_tangent ? f : 0.0;
+    // d(f nu)/du, 3 x m; without the force's terms (force_tangent) only the gap's stiffness; with Kf the force's
+    // terms (f dnu, the normal's rotation; f nu dN_a, the point's slide) go there
+    const bool apart = Kf != nullptr && par.force_tangent;
+    const double fk = par.force_tangent && !apart ? f : 0.0;
     const Eigen::MatrixXd dq = -k * proj.nu * L.dd + fk * L.dnu;
+    if (apart) Kf->setZero(3 * nn, 6 * nn);
     for (int a = 0; a < nn; ++a) {
       const Eigen::RowVectorXd dNa = L.dN(a, 0) * L.dxi.row(0) + L.dN(a, 1) * L.dxi.row(1);
       K->middleRows<3>(3 * a) = w * (L.N[a] * dq + fk * proj.nu * dNa).rightCols(6 * nn);
+      if (apart) Kf->middleRows<3>(3 * a) = w * f * (L.N[a] * L.dnu + proj.nu * dNa).rightCols(6 * nn);
     }
   }
   if (par.beam_tangent) pc.dq_dx = -k * proj.nu * L.dd.head<3>() + f * L.dnu.leftCols<3>();
@@ -155,6 +179,9 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
     const std::span<ProjectionHint> hint = hints.empty() ? std::span<ProjectionHint>{} : hints[k];
     pcs.assign(points.size(), PointContact{});
     NodalContribution nc;  // reused: its buffers are allocated again only after an active point took them
+    // definite_force_terms with averaged normals: the force's terms apart, over the same columns
+    const bool definite = par.averaged_normals && par.compute_tangent && par.force_tangent && par.definite_force_terms;
+    NodalContribution force_nc;
     for (std::size_t i = 0; i < points.size(); ++i) {
       const BeamPoint& bp = points[i];
       PointContact& pc = pcs[i];
@@ -167,8 +194,12 @@ LineContactResult evaluate_line_contact(std::span<const BeamPoint> points,
         if (!sp.found) continue;
         pc.face = sp.face;
         line_point_kernel_averaged(bp, surf.faces[sp.face].kind, S.face_coords(sp.face), S.face_normals(sp.face),
-                                   sp.proj, par, pc, nc.r, K);
-        if (pc.active && K) chain_normals(surf.faces[sp.face], S, par.ring_tangent, nc);
+                                   sp.proj, par, pc, nc.r, K, definite ? &force_nc.K : nullptr);
+        if (pc.active && K) chain_normals(surf.faces[sp.face], S, par.ring_tangent && !definite, nc);
+        if (pc.active && definite) {  // K = K_gap + P+(sym K_f), over the face's nodes
+          chain_normals(surf.faces[sp.face], S, false, force_nc);
+          add_definite_part(force_nc.K, nc.K);
+        }
       } else {
         const SurfaceProjection sp = S.closest(bp.x, par.projection);
         if (!sp.found) continue;

@@ -46,8 +46,9 @@ struct ContactSpec {
   double line_regularization = scene::keys::defaults::contact_line_regularization;
   bool line_averaged_normals =  // LineContactParams::averaged_normals
       std::string_view(scene::keys::defaults::contact_line_normals) == "averaged";
-  bool line_ring_tangent = kLineRingTangentDefault;    // LineContactParams::ring_tangent
-  bool line_force_tangent = kLineForceTangentDefault;  // LineContactParams::force_tangent
+  bool line_ring_tangent = kLineRingTangentDefault;                 // LineContactParams::ring_tangent
+  bool line_force_tangent = kLineForceTangentDefault;               // LineContactParams::force_tangent
+  bool line_definite_force_terms = kLineDefiniteForceTermsDefault;  // LineContactParams::definite_force_terms
   bool log = scene::keys::defaults::contact_log;
 };
 

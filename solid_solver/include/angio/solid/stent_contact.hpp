@@ -54,9 +54,12 @@ struct ContactTiming {
   void reset() { *this = {}; }
 };
 
-// contact.line_tangent's default (keys.yaml) as LineContactParams::ring_tangent and ::force_tangent.
+// contact.line_tangent's default (keys.yaml) as LineContactParams::ring_tangent, ::force_tangent and
+// ::definite_force_terms.
 inline constexpr bool kLineRingTangentDefault = std::string_view(scene::keys::defaults::contact_line_tangent) == "ring";
 inline constexpr bool kLineForceTangentDefault = std::string_view(scene::keys::defaults::contact_line_tangent) != "gap";
+inline constexpr bool kLineDefiniteForceTermsDefault =
+    std::string_view(scene::keys::defaults::contact_line_tangent) == "definite";
 
 // A contact pair that is on at every time (the default of `from`).
 inline constexpr double kAlwaysActive = -std::numeric_limits<double>::infinity();
@@ -71,6 +74,7 @@ class PenaltyStentContact : public StentContact {
     bool averaged_normals = false;                  // projection along the averaged normal field (line_contact.hpp)
     bool ring_tangent = kLineRingTangentDefault;    // LineContactParams::ring_tangent (averaged normals only)
     bool force_tangent = kLineForceTangentDefault;  // LineContactParams::force_tangent
+    bool definite_force_terms = kLineDefiniteForceTermsDefault;  // LineContactParams::definite_force_terms
     std::string balloon_surface = "balloon_outer";
     std::string artery_surface = "artery_inner";
     double balloon_from = kAlwaysActive, artery_from = kAlwaysActive;  // s: off before these times

@@ -56,6 +56,12 @@ struct LineContactParams {
   // "The step where the 0.25 mm wall inverts"). Without them Newton converges linearly to the same solution (the
   // residual is the same). The scene's `contact.line_tangent: gap`.
   bool force_tangent = true;
+  // With force_tangent: the force's terms K_f enter as the positive semidefinite part of their symmetric part,
+  // K = K_gap + P+((K_f + K_f^T)/2) (eigenvalues below zero set to zero), over the face's own nodes (no ring
+  // columns): the stiffening the force's terms give is kept, the indefiniteness a strut's load brings on a soft,
+  // fine lumen (above) left out; the scene's `contact.line_tangent: definite`. (The projection of each contact
+  // term's Hessian onto the definite cone: Teran et al. 2005, Li et al. 2020, "incremental potential contact".)
+  bool definite_force_terms = false;
   bool compute_tangent = true;  // fill NodalContribution::K
   bool beam_tangent = false;    // fill PointContact::dq_dx
   ProjectionOptions projection;
@@ -125,10 +131,12 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
 
 // The same for a point projected along the averaged normal field (LineContactParams::averaged_normals);
 // Nn: the face's nodal normals (SurfaceSearch::face_normals). K = dr/d[X_0..X_{nn-1}, n_0..n_{nn-1}]
-// (3 nn x 6 nn); evaluate_line_contact chains the normal columns to the nodes around the face.
+// (3 nn x 6 nn); evaluate_line_contact chains the normal columns to the nodes around the face. Kf (optional,
+// with K and par.force_tangent): the terms proportional to the force apart, over the same columns; K then holds
+// the rest (the gap's stiffness), K + Kf the full tangent.
 void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX& X, const FaceX& Nn,
                                 const NormalFieldProjection& proj, const LineContactParams& par, PointContact& pc,
-                                Eigen::VectorXd& r, Eigen::MatrixXd* K);
+                                Eigen::VectorXd& r, Eigen::MatrixXd* K, Eigen::MatrixXd* Kf = nullptr);
 
 // Evaluate all points against all surfaces (searches must be update()d with the current coordinates).
 // The contributions of different surfaces add up (a point may touch balloon and artery at the same time).
