@@ -243,7 +243,7 @@ TEST(NormalField, FaceTangentIsTheRingTangentsFaceColumns) {
 }
 
 // The helix's points against a perturbed quarter cylinder of one face kind, searched along the averaged normal
-// field or for the closest point; eval() with the face's columns only (ring_tangent = false) and penalty 10.
+// field or for the closest point; eval() with penalty 10 and the face's columns only unless `ring`.
 struct HelixOnQuarterCylinder {
   test::Mesh m;
   std::vector<BeamPoint> pts;
@@ -254,11 +254,13 @@ struct HelixOnQuarterCylinder {
     if (averaged) S.enable_normal_field();
     S.update(m.x);
   }
-  LineContactResult eval(double g0, bool force, bool definite = false) const {
+  HelixOnQuarterCylinder(const HelixOnQuarterCylinder&) = delete;  // S points into m
+  HelixOnQuarterCylinder& operator=(const HelixOnQuarterCylinder&) = delete;
+  LineContactResult eval(double g0, bool force, bool definite = false, bool ring = false) const {
     LineContactParams par;
     par.penalty = 10.0;
     par.averaged_normals = averaged;
-    par.ring_tangent = false;
+    par.ring_tangent = ring;
     par.regularization = g0;
     par.force_tangent = force;
     par.definite_force_terms = definite;
@@ -305,33 +307,42 @@ TEST(NormalField, GapTangentLeavesOutExactlyTheForceTerms) {
 // positive semidefinite part of the symmetric part S of the force's terms K_f = K_exact - K_gap (face columns).
 // P is that projection exactly when P >= 0, P - S >= 0 and P (P - S) = 0 (the two parts' eigenvectors split the
 // space). The residual is the exact one's; where S has negative eigenvalues (checked: the case the option is for)
-// P differs from S. For the averaged-normal kernel and the closest-point kernel.
+// P differs from S. For the averaged-normal kernel and the closest-point kernel. Asked for the ring's columns
+// too, the definite tangent stays over the face's own nodes (the same contribution). Round-off: P and S are
+// differences of tangents of norm |K|, so the properties hold to a small multiple of eps |K|.
 TEST(NormalField, DefiniteTangentKeepsThePositivePartOfTheForceTerms) {
   for (bool averaged : {true, false})
     for (FaceKind kind : {FaceKind::Quad4, FaceKind::Tri6}) {
       const HelixOnQuarterCylinder h(kind, averaged);  // face columns: the definite tangent has no others
       const LineContactResult exact = h.eval(0.005, true), gap = h.eval(0.005, false), def = h.eval(0.005, true, true);
+      const LineContactResult def_ring = h.eval(0.005, true, true, true);
       ASSERT_EQ(def.solid.size(), 12u);
+      ASSERT_EQ(exact.solid.size(), def.solid.size());
+      ASSERT_EQ(gap.solid.size(), def.solid.size());
+      ASSERT_EQ(def_ring.solid.size(), def.solid.size());
       int indefinite = 0;
       for (std::size_t i = 0; i < def.solid.size(); ++i) {
         const NodalContribution &d = def.solid[i], &g = gap.solid[i], &e = exact.solid[i];
         EXPECT_EQ(d.r, e.r) << name(kind);
         EXPECT_EQ(d.nodes, g.nodes) << name(kind);
+        EXPECT_EQ(def_ring.solid[i].nodes, d.nodes) << name(kind);
+        EXPECT_EQ(def_ring.solid[i].K, d.K) << name(kind);
         ASSERT_EQ(d.K.rows(), d.K.cols()) << name(kind);
+        ASSERT_EQ(e.K.cols(), g.K.cols()) << name(kind);
         const Eigen::MatrixXd Kf = e.K - g.K;
         const Eigen::MatrixXd Sf = 0.5 * (Kf + Kf.transpose());
         const Eigen::MatrixXd P = d.K - g.K;
-        const double scale = Sf.norm();
-        ASSERT_GT(scale, 0.0);
+        const double scale = std::max({Sf.norm(), e.K.norm(), g.K.norm()});
+        ASSERT_GT(Sf.norm(), 0.0);
         EXPECT_LT((P - P.transpose()).norm(), 1e-12 * scale) << name(kind);
         const Eigen::MatrixXd Psym = 0.5 * (P + P.transpose());
         const Eigen::MatrixXd Q = 0.5 * ((P - Sf) + (P - Sf).transpose());
         EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Psym).eigenvalues().minCoeff(), -1e-12 * scale);
         EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Q).eigenvalues().minCoeff(), -1e-12 * scale);
         EXPECT_LT((P * (P - Sf)).norm(), 1e-12 * scale * scale) << name(kind);
-        if (Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Sf).eigenvalues().minCoeff() < -1e-6 * scale) {
+        if (Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Sf).eigenvalues().minCoeff() < -1e-6 * Sf.norm()) {
           ++indefinite;
-          EXPECT_GT((P - Sf).norm(), 1e-6 * scale) << name(kind);
+          EXPECT_GT((P - Sf).norm(), 1e-6 * Sf.norm()) << name(kind);
         }
       }
       EXPECT_GT(indefinite, 0) << name(kind) << " averaged " << averaged;  // the case the option is for

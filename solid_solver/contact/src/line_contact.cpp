@@ -41,13 +41,17 @@ std::optional<PenaltyLaw> start_point(const BeamPoint& bp, double d, int nn, int
   return law;
 }
 
-// A += P+((B + B^T)/2), B square over the face's nodes: the positive semidefinite part of B's symmetric part
-// (LineContactParams::definite_force_terms). Fixed-capacity storage: no allocation per contact point.
+// A += P+((B + B^T)/2), A and B square over the face's nodes: the positive semidefinite part of B's symmetric
+// part (LineContactParams::definite_force_terms), in fixed-capacity storage. An eigensolver that fails (a
+// non-finite B) adds nothing: the point keeps the gap's stiffness alone.
 using FaceSquare =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 3 * kMaxFaceNodes, 3 * kMaxFaceNodes>;
 void add_definite_part(const Eigen::Ref<const Eigen::MatrixXd>& B, Eigen::Ref<Eigen::MatrixXd> A) {
+  if (B.rows() != B.cols() || B.rows() > 3 * kMaxFaceNodes || A.rows() != B.rows() || A.cols() != B.cols())
+    throw std::logic_error("line contact: the definite tangent needs square terms over one face's nodes");
   const FaceSquare S = 0.5 * (B + B.transpose());
   const Eigen::SelfAdjointEigenSolver<FaceSquare> eig(S);
+  if (eig.info() != Eigen::Success) return;
   const auto& lambda = eig.eigenvalues();
   const auto& V = eig.eigenvectors();
   for (Eigen::Index j = 0; j < lambda.size(); ++j)

@@ -133,7 +133,7 @@ void line_point_kernel(const BeamPoint& bp, FaceKind kind, const FaceX& X, doubl
 // Nn: the face's nodal normals (SurfaceSearch::face_normals). K = dr/d[X_0..X_{nn-1}, n_0..n_{nn-1}]
 // (3 nn x 6 nn); evaluate_line_contact chains the normal columns to the nodes around the face. Kf (optional,
 // with K and par.force_tangent): the terms proportional to the force apart, over the same columns; K then holds
-// the rest (the gap's stiffness), K + Kf the full tangent.
+// the rest (the gap's stiffness), K + Kf the full tangent. Kf is written for an active point only.
 void line_point_kernel_averaged(const BeamPoint& bp, FaceKind kind, const FaceX& X, const FaceX& Nn,
                                 const NormalFieldProjection& proj, const LineContactParams& par, PointContact& pc,
                                 Eigen::VectorXd& r, Eigen::MatrixXd* K, Eigen::MatrixXd* Kf = nullptr);
