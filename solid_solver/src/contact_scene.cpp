@@ -83,10 +83,10 @@ ContactSpec read_contact_spec(const Node& root) {
   if (!(spec.line_regularization < 0.5 * spec.search_radius))
     c->child("line_regularization").fail("a value below half of contact.search_radius (mm)");
   spec.line_averaged_normals = c->get<std::string>("line_normals") == "averaged";
-  const std::string line_tangent = c->get<std::string>("line_tangent");
-  spec.line_ring_tangent = line_tangent == "ring";
-  spec.line_force_tangent = line_tangent != "gap";
-  spec.line_definite_force_terms = line_tangent == "definite";
+  const LineTangentFlags line_tangent = line_tangent_flags(c->get<std::string>("line_tangent"));
+  spec.line_ring_tangent = line_tangent.ring;
+  spec.line_force_tangent = line_tangent.force;
+  spec.line_definite_force_terms = line_tangent.definite;
   spec.log = c->get<bool>("log");
   spec.stent_balloon = read_line_pair(*c, "stent_balloon", spec.stent_balloon, spec.stent_balloon_from);
   spec.stent_artery = read_line_pair(*c, "stent_artery", spec.stent_artery, spec.stent_artery_from);

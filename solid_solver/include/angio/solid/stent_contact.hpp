@@ -54,12 +54,18 @@ struct ContactTiming {
   void reset() { *this = {}; }
 };
 
-// contact.line_tangent's default (keys.yaml) as LineContactParams::ring_tangent, ::force_tangent and
-// ::definite_force_terms.
-inline constexpr bool kLineRingTangentDefault = std::string_view(scene::keys::defaults::contact_line_tangent) == "ring";
-inline constexpr bool kLineForceTangentDefault = std::string_view(scene::keys::defaults::contact_line_tangent) != "gap";
-inline constexpr bool kLineDefiniteForceTermsDefault =
-    std::string_view(scene::keys::defaults::contact_line_tangent) == "definite";
+// contact.line_tangent's value (keys.yaml) as LineContactParams::ring_tangent, ::force_tangent and
+// ::definite_force_terms: the one reading of the key, for its default and for a scene (read_contact_spec).
+struct LineTangentFlags {
+  bool ring, force, definite;
+};
+constexpr LineTangentFlags line_tangent_flags(std::string_view value) {
+  return {value == "ring", value != "gap", value == "definite"};
+}
+inline constexpr LineTangentFlags kLineTangentDefault = line_tangent_flags(scene::keys::defaults::contact_line_tangent);
+inline constexpr bool kLineRingTangentDefault = kLineTangentDefault.ring;
+inline constexpr bool kLineForceTangentDefault = kLineTangentDefault.force;
+inline constexpr bool kLineDefiniteForceTermsDefault = kLineTangentDefault.definite;
 
 // A contact pair that is on at every time (the default of `from`).
 inline constexpr double kAlwaysActive = -std::numeric_limits<double>::infinity();
