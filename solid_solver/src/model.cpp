@@ -95,7 +95,7 @@ SolidModel::SolidModel(MPI_Comm comm, Mesh mesh, std::vector<LayerMaterial> mats
     ANGIO_PETSC(VecAssemblyEnd(damping_diag_));
     ANGIO_PETSC(VecDuplicate(damping_diag_, &damping_tangent_));
   }
-  u_.assign(3 * mesh_.X.size(), 0.0);
+  u_.assign(3 * held_.size(), 0.0);
   u_committed_ = u_;
   visc_offset_.assign(local_elements_.size(), -1);
   int nvisc = 0;
@@ -209,6 +209,25 @@ void SolidModel::partition_() {
   local_elements_.clear();
   for (int e = 0; e < ne; ++e)
     if (elem_rank_[e] == rank_) local_elements_.push_back(e);
+  // held: the owned nodes in order, then the other nodes of the local elements (ascending)
+  slot_.assign(nn, -1);
+  held_.clear();
+  for (int i = node_begin_; i < node_end_; ++i) {
+    slot_[iperm_[i]] = int(held_.size());
+    held_.push_back(i);
+  }
+  std::vector<PetscInt> ghosts;
+  for (int e : local_elements_) {
+    const auto& el = mesh_.elements[e];
+    for (int a = 0; a < el.nn(); ++a)
+      if (slot_[el.n[a]] < 0) ghosts.push_back(perm_[el.n[a]]);
+  }
+  std::sort(ghosts.begin(), ghosts.end());
+  ghosts.erase(std::unique(ghosts.begin(), ghosts.end()), ghosts.end());
+  for (PetscInt g : ghosts) {
+    slot_[iperm_[g]] = int(held_.size());
+    held_.push_back(g);
+  }
   // the local elements' nodes in the new numbering, where their tangents go (create_matrix_ finds the slots)
   std::vector<int> offsets{0};
   std::vector<PetscInt> element_nodes;
@@ -223,6 +242,7 @@ void SolidModel::partition_() {
 void SolidModel::set_contact(ContactModel* contact) {
   contact_ = contact;
   if (!contact) return;
+  hold_nodes(contact->held_nodes(*this));
   extra_ = contact->couplings(*this);
   if (!extra_.empty()) create_matrix_();
 }
@@ -332,7 +352,7 @@ void SolidModel::setup_petsc_() {
   create_matrix_();
   ANGIO_PETSC(MatCreateVecs(K_, &du_, &r_));
   ANGIO_PETSC(VecSetBlockSize(du_, 3));
-  ANGIO_PETSC(VecScatterCreateToAll(du_, &scatter_, &full_));
+  create_scatter_();
   ANGIO_PETSC(PetscOptionsCreate(&options_));
   ANGIO_PETSC(PetscOptionsInsertString(options_, petsc_default_options()));
   ANGIO_PETSC(PetscOptionsInsertString(options_, opt_.petsc_options.c_str()));
@@ -414,12 +434,17 @@ void SolidModel::set_part_splits_(PC pc) {
   }
 }
 
-std::vector<Face> SolidModel::owned_faces_(const std::string& name, const char* what) const {
+std::vector<Face> SolidModel::owned_faces_(const std::string& name, const char* what) {
   const SurfaceSet* s = mesh_.surface(name);
   if (!s) throw std::runtime_error(std::string(what) + ": unknown surface set '" + name + "'");
   std::vector<Face> faces;
+  std::vector<int> nodes;  // a face's element may be another rank's: its other nodes are held too
   for (const auto& f : s->faces)
-    if (node_owner_[f.n[0]] == rank_) faces.push_back(f);
+    if (node_owner_[f.n[0]] == rank_) {
+      faces.push_back(f);
+      nodes.insert(nodes.end(), f.n.begin(), f.n.begin() + f.nn());
+    }
+  hold_nodes(nodes);
   return faces;
 }
 
@@ -446,32 +471,95 @@ void SolidModel::add_dirichlet(DirichletBC bc) {
 
 void SolidModel::apply_dirichlet_values_() {
   for (const auto& bc : dirichlet_)
-    for (int n : bc.nodes) u_[dof(n, bc.component)] = bc.value(mesh_.X[n], time_);
+    for (int n : bc.nodes)
+      if (holds(n)) u_[ldof_(n, bc.component)] = bc.value(mesh_.X[n], time_);
+}
+
+void SolidModel::create_scatter_() {
+  if (full_) VecDestroy(&full_);
+  if (scatter_) VecScatterDestroy(&scatter_);
+  IS is;
+  ANGIO_PETSC(ISCreateBlock(PETSC_COMM_SELF, 3, PetscInt(held_.size()), held_.data(), PETSC_COPY_VALUES, &is));
+  ANGIO_PETSC(VecCreateSeq(PETSC_COMM_SELF, 3 * PetscInt(held_.size()), &full_));
+  ANGIO_PETSC(VecScatterCreate(du_, is, full_, nullptr, &scatter_));
+  ISDestroy(&is);
+}
+
+void SolidModel::hold_nodes(const std::vector<int>& nodes) {
+  const size_t before = held_.size();
+  for (int n : nodes) {
+    if (n < 0 || n >= int(mesh_.X.size())) throw std::out_of_range("hold_nodes: node index out of range");
+    if (slot_[n] >= 0) continue;
+    slot_[n] = int(held_.size());
+    held_.push_back(perm_[n]);
+  }
+  int grew = held_.size() > before, any = 0;
+  MPI_Allreduce(&grew, &any, 1, MPI_INT, MPI_MAX, comm_);
+  if (!any || !du_) return;  // before setup_petsc_: the scatter is created there
+  create_scatter_();
+  // the new nodes' displacement from their owners: each held state through a global vector
+  Vec g;
+  ANGIO_PETSC(VecDuplicate(du_, &g));
+  std::vector<double> all;
+  for (std::vector<double>* v : {&u_, &u_committed_, &u_before_}) {
+    int has = v->size() == 3 * before, every = 0;  // u_before_ may be empty (on every rank alike)
+    MPI_Allreduce(&has, &every, 1, MPI_INT, MPI_MIN, comm_);
+    if (!every) continue;
+    PetscScalar* a;
+    ANGIO_PETSC(VecGetArray(g, &a));
+    std::copy(v->begin(), v->begin() + 3 * (node_end_ - node_begin_), a);
+    ANGIO_PETSC(VecRestoreArray(g, &a));
+    gather_(g, all);
+    v->resize(all.size());
+    std::copy(all.begin() + long(3 * before), all.end(), v->begin() + long(3 * before));
+  }
+  VecDestroy(&g);
+}
+
+void SolidModel::restore_state(const std::vector<double>& u) {
+  if (u.size() != u_.size()) throw std::logic_error("restore_state: a state of other held nodes");
+  u_ = u;
 }
 
 Vec3d SolidModel::displacement(int node) const {
-  const int p = 3 * perm_[node];
+  if (slot_[node] < 0)
+    throw std::out_of_range("solid model: rank " + std::to_string(rank_) + " does not hold node " +
+                            std::to_string(node));
+  const int p = 3 * slot_[node];
   return Vec3d(u_[p], u_[p + 1], u_[p + 2]);
 }
 
 void SolidModel::set_displacement(const std::vector<Vec3d>& u) {
   for (size_t n = 0; n < mesh_.X.size(); ++n)
-    for (int k = 0; k < 3; ++k) u_[dof(int(n), k)] = u[n](k);
+    if (holds(int(n)))
+      for (int k = 0; k < 3; ++k) u_[ldof_(int(n), k)] = u[n](k);
 }
 
-Vec3d SolidModel::committed_displacement(int node) const {
-  const int i = 3 * perm_[node];
-  return Vec3d(u_committed_[i], u_committed_[i + 1], u_committed_[i + 2]);
+std::vector<Vec3d> SolidModel::gather_nodes_(const std::vector<double>& v, bool all) const {
+  // the owned nodes' entries (the first 3 (node_end_ - node_begin_) of a held state) in new numbering
+  const int mine = 3 * (node_end_ - node_begin_);
+  std::vector<int> counts(size_), offsets(size_ + 1, 0);
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
+  for (int r = 0; r < size_; ++r) offsets[r + 1] = offsets[r] + counts[r];
+  std::vector<double> whole(all || rank_ == 0 ? offsets[size_] : 0);
+  if (all)
+    MPI_Allgatherv(v.data(), mine, MPI_DOUBLE, whole.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm_);
+  else
+    MPI_Gatherv(v.data(), mine, MPI_DOUBLE, whole.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0, comm_);
+  std::vector<Vec3d> out(whole.empty() ? 0 : mesh_.X.size());
+  for (size_t n = 0; n < out.size(); ++n)
+    for (int k = 0; k < 3; ++k) out[n](k) = whole[3 * size_t(perm_[n]) + k];
+  return out;
 }
 
-bool SolidModel::before_state(double& time, std::vector<Vec3d>* u) const {
-  if (u_before_.size() != u_committed_.size()) return false;
-  time = before_time_;
-  if (u) {
-    u->resize(mesh_.X.size());
-    for (size_t n = 0; n < mesh_.X.size(); ++n)
-      for (int k = 0; k < 3; ++k) (*u)[n](k) = u_before_[dof(int(n), k)];
-  }
+std::vector<Vec3d> SolidModel::gather_displacement() const { return gather_nodes_(u_, true); }
+
+bool SolidModel::gather_committed(std::vector<Vec3d>& u, std::vector<Vec3d>& before, double& before_time) const {
+  u = gather_nodes_(u_committed_, false);
+  before.clear();
+  if (u_before_.size() != u_committed_.size()) return false;  // the same on every rank
+  before = gather_nodes_(u_before_, false);
+  before_time = before_time_;
   return true;
 }
 
@@ -491,20 +579,21 @@ void SolidModel::start_from(double t, const std::vector<Vec3d>& u, const std::ve
   if (!u_before.empty()) {
     u_before_.resize(u_.size());
     for (size_t n = 0; n < mesh_.X.size(); ++n)
-      for (int k = 0; k < 3; ++k) u_before_[dof(int(n), k)] = u_before[n](k);
+      if (holds(int(n)))
+        for (int k = 0; k < 3; ++k) u_before_[ldof_(int(n), k)] = u_before[n](k);
     before_time_ = before_time;
   }
   pc_current_ = false;
 }
 
-void SolidModel::gather_(Vec v, std::vector<double>& full) {
+void SolidModel::gather_(Vec v, std::vector<double>& held) const {
   ANGIO_PETSC(VecScatterBegin(scatter_, v, full_, INSERT_VALUES, SCATTER_FORWARD));
   ANGIO_PETSC(VecScatterEnd(scatter_, v, full_, INSERT_VALUES, SCATTER_FORWARD));
   const PetscScalar* a;
   PetscInt n;
   ANGIO_PETSC(VecGetLocalSize(full_, &n));
   ANGIO_PETSC(VecGetArrayRead(full_, &a));
-  full.assign(a, a + n);
+  held.assign(a, a + n);
   ANGIO_PETSC(VecRestoreArrayRead(full_, &a));
 }
 
@@ -526,10 +615,10 @@ bool SolidModel::assemble(Vec r, Mat K) {
     u.resize(nn, 3);
     idx.resize(3 * nn);
     for (int a = 0; a < nn; ++a) {
-      const int p = 3 * perm_[n[a]];
+      const int p = 3 * perm_[n[a]], l = 3 * slot_[n[a]];
       for (int k = 0; k < 3; ++k) {
         X(a, k) = mesh_.X[n[a]](k);
-        u(a, k) = u_[p + k];
+        u(a, k) = u_[l + k];
         idx[3 * a + k] = p + k;
       }
     }
@@ -582,11 +671,14 @@ bool SolidModel::assemble(Vec r, Mat K) {
   MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
   if (!all_ok) {  // which element (the largest index of those found), for the failure messages
     MPI_Allreduce(&bad, &invalid_element_, 1, MPI_INT, MPI_MAX, comm_);
-    if (invalid_element_ >= 0) {
+    if (invalid_element_ >= 0) {  // its centroid from the rank that holds it
       const auto& el = mesh_.elements[invalid_element_];
-      invalid_at_ = Vec3d::Zero();
-      for (int a = 0; a < el.nn(); ++a) invalid_at_ += position(el.n[a]);
-      invalid_at_ /= double(el.nn());
+      Vec3d c = Vec3d::Zero();
+      if (elem_rank_[invalid_element_] == rank_) {
+        for (int a = 0; a < el.nn(); ++a) c += position(el.n[a]);
+        c /= double(el.nn());
+      }
+      MPI_Allreduce(c.data(), invalid_at_.data(), 3, MPI_DOUBLE, MPI_SUM, comm_);
     }
   }
   if (all_ok && contact_) {
@@ -632,7 +724,8 @@ void SolidModel::lift_prescribed_increment_(SolveReport& rep) {
   int any = 0;
   for (const auto& bc : dirichlet_)
     for (int n : bc.nodes) {
-      const int d = dof(n, bc.component);
+      if (!holds(n)) continue;
+      const int d = ldof_(n, bc.component);
       if (u_target[d] != u_[d]) any = 1;
     }
   int any_global = 0;
@@ -645,7 +738,10 @@ void SolidModel::lift_prescribed_increment_(SolveReport& rep) {
   rep.assembly_seconds += MPI_Wtime() - tl;
   if (!lok) return;
   std::vector<PetscScalar> inc(dirichlet_rows_.size());
-  for (size_t i = 0; i < dirichlet_rows_.size(); ++i) inc[i] = u_target[dirichlet_rows_[i]] - u_[dirichlet_rows_[i]];
+  for (size_t i = 0; i < dirichlet_rows_.size(); ++i) {  // owned rows: held entry = row - 3 node_begin_
+    const PetscInt l = dirichlet_rows_[i] - 3 * node_begin_;
+    inc[i] = u_target[l] - u_[l];
+  }
   ANGIO_PETSC(VecSet(du_, 0.0));
   ANGIO_PETSC(VecSetValues(du_, PetscInt(inc.size()), dirichlet_rows_.data(), inc.data(), INSERT_VALUES));
   ANGIO_PETSC(VecAssemblyBegin(du_));
@@ -801,7 +897,7 @@ double SolidModel::slope_along_(const std::vector<double>& du_full) {
   const PetscScalar* r;
   ANGIO_PETSC(VecGetArrayRead(r_, &r));
   double local = 0.0;
-  for (int i = 3 * node_begin_; i < 3 * node_end_; ++i) local += du_full[i] * r[i - 3 * node_begin_];
+  for (int i = 0; i < 3 * (node_end_ - node_begin_); ++i) local += du_full[i] * r[i];  // owned: held first
   ANGIO_PETSC(VecRestoreArrayRead(r_, &r));
   double global = 0.0;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_SUM, comm_);
@@ -810,39 +906,43 @@ double SolidModel::slope_along_(const std::vector<double>& du_full) {
 
 void SolidModel::log_newton_iteration_(int it, double res, double alpha, PetscInt lits, bool stale,
                                        const std::vector<double>& du_full) {
-  // where the residual is largest: which part of the model keeps Newton from converging
-  PetscInt at = -1;
+  // where the residual is largest: which part of the model keeps Newton from converging; and where
+  // the Newton step moves a node farthest (the full step, before the line search's alpha): a step
+  // that inverts elements shows where. Each rank over its owned nodes, the largest of all on rank 0.
   PetscReal rmax = 0.0;
   ANGIO_PETSC(VecNorm(r_, NORM_INFINITY, &rmax));
+  struct Largest {
+    double value = -1.0;
+    int node = -1;
+    Vec3d x = Vec3d::Zero();
+  } r_at, du_at;
   {
     const PetscScalar* a;
-    PetscInt lo, hi;
-    ANGIO_PETSC(VecGetOwnershipRange(r_, &lo, &hi));
     ANGIO_PETSC(VecGetArrayRead(r_, &a));
-    for (PetscInt i = lo; i < hi; ++i)
-      if (std::abs(a[i - lo]) == rmax) at = i;
+    for (int i = 0; i < 3 * (node_end_ - node_begin_); ++i)
+      if (std::abs(a[i]) == rmax) r_at = {double(rmax), iperm_[node_begin_ + i / 3], Vec3d::Zero()};
     ANGIO_PETSC(VecRestoreArrayRead(r_, &a));
   }
-  PetscInt at_global = -1;
-  MPI_Allreduce(&at, &at_global, 1, MPIU_INT, MPI_MAX, comm_);
-  if (rank_ == 0) {
-    const int node = at_global >= 0 ? iperm_[at_global / 3] : -1;
-    const Vec3d x = node >= 0 ? position(node) : Vec3d::Zero();
-    // where the Newton step moves a node farthest (the full step, before the line search's alpha):
-    // a step that inverts elements shows where
-    double dmax = 0.0;
-    int dnode = -1;
-    for (size_t a = 0; 3 * a + 2 < du_full.size(); ++a) {
-      const double d = std::hypot(du_full[3 * a], du_full[3 * a + 1], du_full[3 * a + 2]);
-      if (d > dmax) dmax = d, dnode = iperm_[a];
-    }
-    const Vec3d y = dnode >= 0 ? position(dnode) : Vec3d::Zero();
-    std::printf(
-        "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)  "
-        "max |du| %.2e mm at node %d (%.3f, %.3f, %.3f)\n",
-        it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), node, x(0), x(1), x(2), dmax,
-        dnode, y(0), y(1), y(2));
+  for (int a = 0; a < node_end_ - node_begin_; ++a) {
+    const double d = std::hypot(du_full[3 * a], du_full[3 * a + 1], du_full[3 * a + 2]);
+    if (d > du_at.value) du_at = {d, iperm_[node_begin_ + a], Vec3d::Zero()};
   }
+  for (Largest* l : {&r_at, &du_at})
+    if (l->node >= 0) l->x = position(l->node);
+  // rows of (value, node, x, y, z) per rank, the first rank's largest kept
+  const double mine[10] = {r_at.value,  double(r_at.node),  r_at.x(0),  r_at.x(1),  r_at.x(2),
+                           du_at.value, double(du_at.node), du_at.x(0), du_at.x(1), du_at.x(2)};
+  std::vector<double> all(rank_ == 0 ? 10 * size_ : 0);
+  MPI_Gather(mine, 10, MPI_DOUBLE, all.data(), 10, MPI_DOUBLE, 0, comm_);
+  if (rank_ != 0) return;
+  for (int r = 1; r < size_; ++r)
+    for (int k : {0, 5})
+      if (all[10 * r + k] > all[k]) std::copy(all.begin() + 10 * r + k, all.begin() + 10 * r + k + 5, all.begin() + k);
+  std::printf(
+      "    newton %2d  |r| = %.3e  alpha = %.3g  ksp its = %d%s  max |r_i| %.2e at node %d (%.3f, %.3f, %.3f)  "
+      "max |du| %.2e mm at node %d (%.3f, %.3f, %.3f)\n",
+      it + 1, res, alpha, int(lits), stale ? " (old factorization)" : "", double(rmax), int(all[1]), all[2], all[3],
+      all[4], std::max(all[5], 0.0), int(all[6]), all[7], all[8], all[9]);
 }
 
 SolveReport SolidModel::solve(double loose_atol) {
@@ -943,9 +1043,8 @@ double SolidModel::damping_(Vec r, Mat K) {
   if (r) ANGIO_PETSC(VecGetArray(r, &rr));
   if (K) ANGIO_PETSC(VecGetArray(damping_tangent_, &kk));
   double local = 0.0;
-  for (int i = 3 * node_begin_; i < 3 * node_end_; ++i) {
-    const int j = i - 3 * node_begin_;
-    const double f = d[j] * (u_[i] - u_committed_[i]) / dt;
+  for (int j = 0; j < 3 * (node_end_ - node_begin_); ++j) {  // owned dofs: the held state's first
+    const double f = d[j] * (u_[j] - u_committed_[j]) / dt;
     if (rr) rr[j] += f;
     if (kk) kk[j] = d[j] / dt;
     local += f * f;
@@ -1057,12 +1156,12 @@ std::vector<Vec3d> SolidModel::contact_forces(ContactModel& c) {
   c.add(*this, f, nullptr);
   ANGIO_PETSC(VecAssemblyBegin(f));
   ANGIO_PETSC(VecAssemblyEnd(f));
-  std::vector<double> full;
-  gather_(f, full);
+  std::vector<double> held;
+  gather_(f, held);
   ANGIO_PETSC(VecDestroy(&f));
-  std::vector<Vec3d> out(mesh_.X.size());
-  for (size_t n = 0; n < mesh_.X.size(); ++n)
-    for (int k = 0; k < 3; ++k) out[n](k) = -full[3 * perm_[n] + k];  // residual r = f_int − f_ext
+  std::vector<Vec3d> out(mesh_.X.size(), Vec3d::Zero());
+  for (size_t i = 0; i < held_.size(); ++i)
+    for (int k = 0; k < 3; ++k) out[iperm_[held_[i]]](k) = -held[3 * i + k];  // residual r = f_int − f_ext
   return out;
 }
 

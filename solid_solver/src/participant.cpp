@@ -73,7 +73,12 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     for (size_t i = 0; i < nodes.size(); ++i) st[i] = scene_.lumen->station(mesh.X[nodes[i]]);
     lumen_ = LumenProfile(nodes, st, scene_.lumen_max_stations);
     endothelium_area_ = nodal_areas(mesh, *endo);
+    lumen_nodes_ = std::move(nodes);
   }
+  // what the per-step measures read on every rank: the balloon's rings and the lumen
+  std::vector<int> measured = lumen_nodes_;
+  for (const auto* r : {&ring_mid_, &ring_end0_, &ring_end1_}) measured.insert(measured.end(), r->begin(), r->end());
+  model_->hold_nodes(measured);
   recovery_ = std::make_unique<StressRecovery>(*model_);
   nodal_stress_names_ = nodal_stress_field_names(model_->mesh());
   time_ = scene_.time.start;
@@ -323,16 +328,21 @@ void SolidRunner::nodal_stress_(StepSummary& s) const {
 
 void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_pressure) {
   const auto& mesh = model_->mesh();
-  std::vector<Vec3d> x(mesh.X.size());
-  for (size_t n = 0; n < x.size(); ++n) x[n] = model_->position(int(n));
-  // maximum displacement per part (the prestressed state: paper 0.14 mm)
-  std::map<std::string, double> umax;
-  for (const auto& el : mesh.elements) {
-    double& m = umax[mesh.blocks[el.block].part];
-    for (int a = 0; a < el.nn(); ++a) m = std::max(m, (x[el.n[a]] - mesh.X[el.n[a]]).norm());
+  // maximum displacement per part (the prestressed state: paper 0.14 mm), over each rank's elements
+  const std::vector<std::string> parts = part_names(mesh);
+  std::vector<double> umax(parts.size(), 0.0), all(parts.size(), 0.0);
+  for (int e : model_->local_elements()) {
+    const auto& el = mesh.elements[e];
+    double& m = umax[std::find(parts.begin(), parts.end(), mesh.blocks[el.block].part) - parts.begin()];
+    for (int a = 0; a < el.nn(); ++a) m = std::max(m, model_->displacement(el.n[a]).norm());
   }
-  for (const auto& [part, u] : umax) s.max_displacement.emplace_back(part, u);
+  MPI_Allreduce(umax.data(), all.data(), int(parts.size()), MPI_DOUBLE, MPI_MAX, comm_);
+  std::map<std::string, double> by_name;  // in the order of the parts' names
+  for (size_t k = 0; k < parts.size(); ++k) by_name[parts[k]] = all[k];
+  for (const auto& [part, u] : by_name) s.max_displacement.emplace_back(part, u);
   if (lumen_.empty()) return;
+  std::vector<Vec3d> x(mesh.X.size(), Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  for (int n : lumen_nodes_) x[n] = model_->position(n);  // held: the lumen's diameters read these
   s.lumen_diameter = lumen_.diameters(x, &s.lumen_centroid);
   if (!stent_x_.empty()) {  // where the stent sits, in the station coordinate of the lumen profile
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -439,6 +449,10 @@ void SolidRunner::record_and_write_(int step, double time) {
   write_summary_();
 }
 
+namespace {
+constexpr int kPerRank = 5;  // the figures per rank of write_summary_()
+}  // namespace
+
 void SolidRunner::write_summary_() {
   if (!writer_) return;
   // Per rank, gathered on rank 0 for summary.json: the peak resident set (getrusage, KiB on Linux)
@@ -448,14 +462,15 @@ void SolidRunner::write_summary_() {
   // (docs/performance.md, "Solid memory and messages per rank"). One gather per commit.
   // The peak before the first solve splits what the setup holds (the mesh every rank reads, the model,
   // the matrix's pattern, the contact's structures) from what the solves add (the factorizations).
-  const double mine[4] = {double(peak_resident_kib()),
-                          0.5 * (petsc_irecv_ct + petsc_isend_ct + petsc_recv_ct + petsc_send_ct),
-                          0.5 * (petsc_irecv_len + petsc_isend_len + petsc_recv_len + petsc_send_len),
-                          double(setup_peak_kib_ < 0 ? peak_resident_kib() : setup_peak_kib_)};
+  // And the nodes whose displacement each rank holds (SolidModel::hold_nodes).
+  const double mine[kPerRank] = {
+      double(peak_resident_kib()), 0.5 * (petsc_irecv_ct + petsc_isend_ct + petsc_recv_ct + petsc_send_ct),
+      0.5 * (petsc_irecv_len + petsc_isend_len + petsc_recv_len + petsc_send_len),
+      double(setup_peak_kib_ < 0 ? peak_resident_kib() : setup_peak_kib_), double(model_->num_held_nodes())};
   int size = 1;
   MPI_Comm_size(comm_, &size);
-  std::vector<double> per_rank(rank_ == 0 ? 4 * size : 0);
-  MPI_Gather(mine, 4, MPI_DOUBLE, per_rank.data(), 4, MPI_DOUBLE, 0, comm_);
+  std::vector<double> per_rank(rank_ == 0 ? kPerRank * size : 0);
+  MPI_Gather(mine, kPerRank, MPI_DOUBLE, per_rank.data(), kPerRank, MPI_DOUBLE, 0, comm_);
   // the matrix's allocated entries (its pattern, contact couplings included): what every
   // factorization's fill starts from
   MatInfo info{};
@@ -509,12 +524,13 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
     const auto& t = totals_;
     int ranks = 1;
     MPI_Comm_size(comm_, &ranks);
-    std::vector<double> peak_mib, messages, message_mib, setup_mib;
-    for (size_t r = 0; r + 3 < per_rank.size(); r += 4) {
+    std::vector<double> peak_mib, messages, message_mib, setup_mib, held;
+    for (size_t r = 0; r + kPerRank <= per_rank.size(); r += kPerRank) {
       peak_mib.push_back(per_rank[r] / 1024.0);
       messages.push_back(per_rank[r + 1]);
       message_mib.push_back(per_rank[r + 2] / (1024.0 * 1024.0));
       setup_mib.push_back(per_rank[r + 3] / 1024.0);
+      held.push_back(per_rank[r + 4]);
     }
     j["timing"] = {{"ranks", ranks},
                    {"dofs", model_->num_dofs()},
@@ -535,12 +551,14 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
                    {"setup_memory_mib_per_rank", setup_mib},
                    {"petsc_messages_per_rank", messages},
                    {"petsc_message_mib_per_rank", message_mib},
+                   {"held_nodes_per_rank", held},
                    {"note",
                     "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest; "
                     "*_per_rank in rank order, so far in the run: the peak resident set (getrusage), the same before "
                     "the first solve (setup: libraries, the mesh, the model, the matrix's pattern, the contact's "
-                    "structures) and PETSc's messages and their volume as -log_view counts them (not MUMPS' own "
-                    "traffic)"}};
+                    "structures), PETSc's messages and their volume as -log_view counts them (not MUMPS' own "
+                    "traffic), and the nodes whose displacement the rank holds (its own, the other nodes of its "
+                    "elements and faces, the contact surfaces' and the measured ones)"}};
   }
   j["steps"] = ordered_json::array();
   for (const auto& s : history_) {

@@ -65,6 +65,9 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
     for (int g = 0; g < v.points; ++g) mine.insert(mine.end(), v.Sv[g].data(), v.Sv[g].data() + 6);
   }
   const std::vector<double> all = gather_on_root(model.comm(), mine);
+  std::vector<Vec3d> committed, before;
+  double before_time = 0.0;
+  const bool has_before = model.gather_committed(committed, before, before_time);  // on rank 0
   if (model.rank() != 0) return;
   std::map<int, size_t> at;  // element -> offset of its row in `all`
   for (size_t k = 0; k < all.size(); k += 2 + 12 * size_t(all[k + 1])) at[int(all[k])] = k;
@@ -78,9 +81,6 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
     write_attribute(file, "format", H5T_NATIVE_INT, &format);
     write_attribute(file, "time", H5T_NATIVE_DOUBLE, &time);
     write_attribute(file, "step", H5T_NATIVE_INT, &step);
-    double before_time = 0.0;
-    std::vector<Vec3d> before;
-    const bool has_before = model.before_state(before_time, &before);
     H5Id parts(H5Gcreate2(file, "parts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
     for (const auto& name : part_names(mesh)) {
       H5Id g(H5Gcreate2(parts, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
@@ -88,7 +88,7 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
       std::vector<Vec3d> X(nodes.size()), u(nodes.size()), ub(nodes.size());
       for (size_t i = 0; i < nodes.size(); ++i) {
         X[i] = mesh.X[nodes[i]];
-        u[i] = model.committed_displacement(nodes[i]);
+        u[i] = committed[nodes[i]];
         if (has_before) ub[i] = before[nodes[i]];
       }
       write_rows(g, "coordinates", X);

@@ -18,18 +18,31 @@ namespace angio::solid {
 
 namespace {
 
-void gather_coords(const SolidModel& model, std::vector<contact::Vec3>& coords) {
-  const int n = int(model.mesh().X.size());
-  coords.resize(n);
-  for (int i = 0; i < n; ++i) coords[i] = model.position(i);
+// The current positions of `nodes` (the contact's surfaces' nodes, which the model holds on every
+// rank) into coords, indexed by node as the surfaces' faces are; the other entries stay NaN.
+void gather_coords(const SolidModel& model, const std::vector<int>& nodes, std::vector<contact::Vec3>& coords) {
+  if (coords.size() != model.mesh().X.size())
+    coords.assign(model.mesh().X.size(), contact::Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
+  for (int n : nodes) coords[n] = model.position(n);
 }
 
-// Whether the model's node positions are bit for bit `coords` (the configuration an evaluation saw).
-bool same_positions(const SolidModel& model, const std::vector<contact::Vec3>& coords) {
+// Whether the model's positions of `nodes` are bit for bit `coords` (the configuration an evaluation saw).
+bool same_positions(const SolidModel& model, const std::vector<int>& nodes, const std::vector<contact::Vec3>& coords) {
   if (coords.size() != model.mesh().X.size()) return false;
-  for (size_t i = 0; i < coords.size(); ++i)
-    if (coords[i] != model.position(int(i))) return false;
+  for (int n : nodes)
+    if (coords[n] != model.position(n)) return false;
   return true;
+}
+
+// The nodes of the surfaces' faces, ascending.
+std::vector<int> face_nodes(std::initializer_list<const contact::Surface*> surfaces) {
+  std::vector<int> nodes;
+  for (const contact::Surface* s : surfaces)
+    if (s)
+      for (const auto& f : s->faces) nodes.insert(nodes.end(), f.nodes.begin(), f.nodes.begin() + f.nn());
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
 }
 
 // Adds contributions (r = dPi/dX on the first r.size()/3 nodes, K = dr/dX over all nodes) with the model's global
@@ -113,6 +126,12 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
   };
   add_surface(opt_.balloon_surface, opt_.balloon_penalty, opt_.balloon_from);
   add_surface(opt_.artery_surface, opt_.artery_penalty, opt_.artery_from);
+  for (const auto& sf : surfaces_) {
+    const std::vector<int> n = face_nodes({sf.get()});
+    nodes_.insert(nodes_.end(), n.begin(), n.end());
+  }
+  std::sort(nodes_.begin(), nodes_.end());
+  nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
   last_.min_gap = opt_.search_radius;
 }
 
@@ -142,7 +161,7 @@ std::vector<contact::LineContactResult> PenaltyStentContact::evaluate_(const Sol
                                                                        std::size_t first, bool tangent, bool all) {
   std::vector<contact::LineContactResult> per_surface;
   if (points.empty() || searches_.empty()) return per_surface;
-  gather_coords(model, coords_);
+  gather_coords(model, nodes_, coords_);
   for (size_t k = 0; k < searches_.size(); ++k) {
     if (!all && !on_(k, model)) continue;
     searches_[k]->update(coords_, /*rebuild=*/!built_[k], /*normal_derivatives=*/tangent);
@@ -210,7 +229,7 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
   // every rank: identical data, no communication; the last assembly's when it saw this configuration
-  const bool reuse = !last_eval_.empty() && same_positions(model, last_eval_coords_);
+  const bool reuse = !last_eval_.empty() && same_positions(model, nodes_, last_eval_coords_);
   const auto per_surface = reuse ? std::move(last_eval_) : evaluate_(model, points_, 0, false, true);
   last_eval_.clear();
   if (per_surface.empty()) return;
@@ -276,6 +295,7 @@ PenaltySurfaceContact::PenaltySurfaceContact(const SolidModel& model, Options op
   }
   if (!slave_->faces.empty()) ss_ = std::make_unique<contact::SurfaceSearch>(*slave_, opt_.search_radius);
   sm_ = std::make_unique<contact::SurfaceSearch>(*master_, opt_.search_radius);
+  nodes_ = face_nodes({slave_.get(), master_.get()});  // this rank's slice of the slave's, with one pass
   last_.min_gap = opt_.search_radius;
 }
 
@@ -291,7 +311,7 @@ void PenaltySurfaceContact::evaluate_(const SolidModel& model, bool tangent) {
   // while the pair is off (the same time on every rank: the reduction below stays collective)
   const bool mine = model.time() >= opt_.from && (opt_.two_pass ? model.rank() == 0 : ss_ != nullptr);
   if (mine) {
-    gather_coords(model, coords_);
+    gather_coords(model, nodes_, coords_);
     ss_->update(coords_);
     sm_->update(coords_);
     contact::SurfaceContactParams par;
@@ -371,6 +391,15 @@ std::vector<NodeCoupling> all_couplings(ContactModel* stent, const std::vector<C
 
 std::vector<NodeCoupling> CompositeContact::couplings(const SolidModel& model) const {
   return all_couplings(stent_, others_, [&](ContactModel& m) { return m.couplings(model); });
+}
+
+std::vector<int> CompositeContact::held_nodes(const SolidModel& model) const {
+  std::vector<int> out = stent_ ? stent_->held_nodes(model) : std::vector<int>{};
+  for (auto* m : others_) {
+    const std::vector<int> n = m->held_nodes(model);
+    out.insert(out.end(), n.begin(), n.end());
+  }
+  return out;
 }
 
 std::vector<NodeCoupling> CompositeContact::prepare(const SolidModel& model, bool tangent) {

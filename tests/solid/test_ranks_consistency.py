@@ -2,7 +2,8 @@
 """Consistency of the distributed solid: 1 vs 2 vs 4 ranks give the same state to round-off.
 
 The scene (data/ranks_balloon_artery.yaml) inflates a balloon into contact with a two-layer artery
-whose media has a viscous branch: element assembly across partition boundaries, the balloon-artery
+whose media has a viscous branch: element assembly across partition boundaries, the displacement
+each rank holds (its own nodes, its elements' others, the contact surfaces'), the balloon-artery
 contact search and its tangent, the viscous history per Gauss point, the stress summary's reductions
 and the state file's gather all depend on the partition. Newton is exact and converged to |r| of
 1e-11 N or below, with a direct solver, so two rank counts can differ only by the rounding of their
@@ -66,6 +67,16 @@ def run(bin_dir, ranks, run_dir):
     check(
         len(msgs) == ranks and (msgs == [0.0] if ranks == 1 else all(m > 0 for m in msgs)),
         f"{ranks} rank(s): summary.json gives each rank's PETSc messages (got {msgs})",
+    )
+    # the nodes whose displacement each rank holds: every node on one rank; on more, each rank fewer
+    # than all (its own, the rest of its elements', the contact surfaces' and the measured ones) and
+    # every node held by its owner at least
+    held = summary["timing"].get("held_nodes_per_rank", [])
+    total = sum(len(v) for v in u.values())
+    check(
+        len(held) == ranks
+        and (held == [float(total)] if ranks == 1 else all(h < total for h in held) and sum(held) >= total),
+        f"{ranks} rank(s): each rank holds the displacement of its part of the {total} nodes (got {held})",
     )
     return u, summary["steps"]
 

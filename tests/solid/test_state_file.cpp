@@ -91,9 +91,7 @@ std::vector<Vec3d> run(const std::string& scene, const std::string& run_dir) {
   const auto time = sc.time;
   SolidRunner runner(PETSC_COMM_WORLD, std::move(sc), run_dir);
   EXPECT_EQ(angio::participant::run_standalone(runner, time), 0);
-  std::vector<Vec3d> u;
-  for (size_t n = 0; n < runner.model().mesh().X.size(); ++n) u.push_back(runner.model().displacement(int(n)));
-  return u;
+  return runner.model().gather_displacement();
 }
 
 double max_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) {
@@ -148,8 +146,7 @@ TEST(StateFile, ContinuedRunEndsWhereTheUninterruptedRunEnds) {
   const auto time = sc.time;
   SolidRunner fresh(PETSC_COMM_WORLD, std::move(sc), "");
   ASSERT_EQ(angio::participant::run_standalone(fresh, time), 0);
-  std::vector<Vec3d> uf;
-  for (size_t n = 0; n < fresh.model().mesh().X.size(); ++n) uf.push_back(fresh.model().displacement(int(n)));
+  const std::vector<Vec3d> uf = fresh.model().gather_displacement();
   EXPECT_GT(max_difference(whole, uf), 1e3 * diff + 1e-8);
 }
 
@@ -162,9 +159,9 @@ TEST(StateFile, PartsLandOnTheirNodesOthersStartUndeformed) {
   const auto nodes = part_nodes(mesh, "artery");
   ASSERT_EQ(nodes.size(), state.parts[0].u.size());
   double diff = 0.0, balloon = 0.0;
-  for (size_t i = 0; i < nodes.size(); ++i)
-    diff = std::max(diff, (runner.model().displacement(nodes[i]) - state.parts[0].u[i]).norm());
-  for (int n : part_nodes(mesh, "balloon")) balloon = std::max(balloon, runner.model().displacement(n).norm());
+  const std::vector<Vec3d> u = runner.model().gather_displacement();
+  for (size_t i = 0; i < nodes.size(); ++i) diff = std::max(diff, (u[nodes[i]] - state.parts[0].u[i]).norm());
+  for (int n : part_nodes(mesh, "balloon")) balloon = std::max(balloon, u[n].norm());
   EXPECT_EQ(diff, 0.0);
   EXPECT_EQ(balloon, 0.0);
   EXPECT_GT(state.parts[0].u[0].norm(), 0.0);

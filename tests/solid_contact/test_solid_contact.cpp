@@ -508,7 +508,7 @@ BAResult balloon_artery_run(MPI_Comm comm, const std::string& petsc_options = ""
     res.mallocs += info.mallocs;
   }
   res.pattern_rebuilds = model.pattern_rebuilds();
-  for (size_t i = 0; i < model.mesh().X.size(); ++i) res.max_u = std::max(res.max_u, model.displacement(int(i)).norm());
+  for (const Vec3d& u : model.gather_displacement()) res.max_u = std::max(res.max_u, u.norm());
   res.force = ba.last().force;
   res.force_magnitude = ba.last().force_magnitude;
   res.min_gap = ba.last().min_gap;

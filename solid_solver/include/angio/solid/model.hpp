@@ -4,8 +4,10 @@
 // the element dual graph, or contiguous blocks); each node is owned by the lowest rank among
 // its elements and nodes are renumbered so that every rank owns one contiguous block of DOFs
 // (3 per node, interlaced). Each rank assembles its own elements into an MPIAIJ matrix
-// (block size 3, preallocated) and a residual vector. The total displacement is kept as a full
-// copy on every rank (VecScatterCreateToAll after each Newton update).
+// (block size 3, preallocated) and a residual vector. Each rank holds the displacement of its owned
+// nodes, of the other nodes of its elements and faces, and of the nodes a contact model or a
+// measure reads on every rank (hold_nodes: the contact surfaces, the lumen, the balloon's rings);
+// each Newton update scatters the increment to those nodes only.
 #pragma once
 #include <mpi.h>
 #include <petscksp.h>
@@ -44,6 +46,9 @@ class ContactModel {
   // the start. An entry outside the pattern makes PETSc's AIJ matrix reallocate and copy itself on
   // insertion: measured at 85 % of the solid's time in the patient-like scene's first contact steps.
   virtual std::vector<NodeCoupling> couplings(const SolidModel&) const { return {}; }
+  // The nodes (original numbering) whose current positions it reads on every rank, e.g. its
+  // surfaces' for their search: the model holds them (SolidModel::hold_nodes) from set_contact() on.
+  virtual std::vector<int> held_nodes(const SolidModel&) const { return {}; }
   // Called collectively by every assembly before add(), with the same configuration: a model whose pairs
   // depend on where the surfaces are (balloon-artery Gauss points and the master faces they project
   // onto) evaluates them here and returns the couplings of the pairs it has not returned before; the
@@ -225,17 +230,18 @@ class SolidModel {
   // The levels the loads follow at pseudo-time t: each pressure, each prescribed displacement's value
   // at its first node, then the contact model's (ContactModel::load_levels).
   std::vector<double> load_levels(double t) const;
-  // The whole displacement (new numbering, every rank): a solve's starting point, kept and restored
+  // The displacement this rank holds (hold_nodes' order): a solve's starting point, kept and restored
   // by a continuation within the step (rollback() returns to the committed state instead).
   const std::vector<double>& state() const { return u_; }
-  const std::vector<double>& committed_state() const { return u_committed_; }  // the same numbering
-  void restore_state(const std::vector<double>& u) { u_ = u; }
+  const std::vector<double>& committed_state() const { return u_committed_; }  // the same order
+  void restore_state(const std::vector<double>& u);
 
   // --- the committed state, as state files keep it (state_file.hpp)
   double committed_time() const { return committed_time_; }
-  Vec3d committed_displacement(int node) const;  // original node index
-  // The commit before the last one (newton.extrapolate): its time, and its displacement (false: none)
-  bool before_state(double& time, std::vector<Vec3d>* u) const;
+  // Collective: the committed displacement of every node (original index) on rank 0, and the commit
+  // before it (newton.extrapolate) with its time; empty vectors on the other ranks. False: no commit
+  // before (before left empty on every rank).
+  bool gather_committed(std::vector<Vec3d>& u, std::vector<Vec3d>& before, double& before_time) const;
   // Viscous history of local element i (local_elements() order): its Gauss points' committed Q and
   // Sv (points = 0: no viscous branch). Writable only between steps, before a solve uses it.
   struct ViscousState {
@@ -249,7 +255,7 @@ class SolidModel {
   // values are applied at t. The viscous history is set through viscous_state().
   void start_from(double t, const std::vector<Vec3d>& u, const std::vector<Vec3d>& u_before, double before_time);
 
-  // --- access (all ranks hold the full displacement)
+  // --- access (each rank the displacement of the nodes it holds)
   MPI_Comm comm() const { return comm_; }
   int rank() const { return rank_; }
   int size() const { return size_; }
@@ -263,9 +269,17 @@ class SolidModel {
   int owned_node_end() const { return node_end_; }
   const std::vector<int>& local_elements() const { return local_elements_; }
   const std::vector<int>& element_rank() const { return elem_rank_; }
-  Vec3d displacement(int node) const;
+  // Collective: from now on this rank also holds the displacement of `nodes` (original numbering; any
+  // rank may pass any nodes, or none). Between solves only: a state() kept before does not fit after.
+  void hold_nodes(const std::vector<int>& nodes);
+  bool holds(int node) const { return slot_[node] >= 0; }
+  int num_held_nodes() const { return int(held_.size()); }
+  Vec3d displacement(int node) const;  // of a node this rank holds (std::out_of_range otherwise)
   Vec3d position(int node) const { return mesh_.X[node] + displacement(node); }
   void set_displacement(const std::vector<Vec3d>& u);  // by original node index (same on all ranks)
+  // Collective: the current displacement of every node (original index) on every rank, a whole-mesh
+  // vector per rank: for tests and checks, not for a solver's loops.
+  std::vector<Vec3d> gather_displacement() const;
   // Per local element (order of local_elements()): first principal Cauchy stress (Gauss-point
   // averaged Cauchy tensor) and its unit direction.
   // volume (optional): reference volume of each local element.
@@ -274,7 +288,8 @@ class SolidModel {
   void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume = nullptr,
                       std::vector<Mat3>* gauss = nullptr) const;
   // Nodal forces that contact model c exerts on the solid at the current state (−its residual
-  // contribution), full vector by original node index on every rank. Collective.
+  // contribution), by original node index, at the nodes this rank holds (zero elsewhere: the contact
+  // model's own surfaces are held, ContactModel::held_nodes). Collective.
   std::vector<Vec3d> contact_forces(ContactModel& c);
   // Assemble residual (and tangent) at the current state; for tests. Returns false on invalid state.
   bool assemble(Vec r, Mat K);
@@ -304,9 +319,17 @@ class SolidModel {
   // PCFIELDSPLIT: one split per mesh part, named after it.
   void set_part_splits_(PC pc);
   void apply_dirichlet_values_();
-  void gather_(Vec v, std::vector<double>& full);
+  // v (a global vector) at the held nodes, in their order (scatter_)
+  void gather_(Vec v, std::vector<double>& held) const;
+  // (Re)creates scatter_ and full_ for the held nodes (collective).
+  void create_scatter_();
+  // The held state's entry of a node's component (the node must be held).
+  int ldof_(int node, int comp) const { return 3 * slot_[node] + comp; }
+  // Collective: v (held order) of every node by original index, on every rank (all) or on rank 0 only.
+  std::vector<Vec3d> gather_nodes_(const std::vector<double>& v, bool all) const;
   // Faces of surface set `name` assembled by this rank (those whose first node it owns); `what` names the load.
-  std::vector<Face> owned_faces_(const std::string& name, const char* what) const;
+  // Their nodes are held (collective).
+  std::vector<Face> owned_faces_(const std::string& name, const char* what);
 
   // --- the steps of solve()'s Newton iteration (collective)
   // What the linear solve leaves one Newton iteration (newton_linear_solve_).
@@ -356,7 +379,13 @@ class SolidModel {
   ContactModel* contact_ = nullptr;
   double time_ = 0.0, committed_time_ = 0.0;
   bool apply_bc_ = true;
-  std::vector<double> u_, u_committed_;  // full copies, new numbering
+  // The held nodes in new numbering, owned ones first (node_begin_.. in order, so that owned dof i of
+  // a global vector is entry i - 3 node_begin_ of the held state), then the others; slot_ per
+  // original node: its place among them, -1 if not held (an int per node of the whole mesh, which
+  // every rank holds anyway, docs/design.md §7.2).
+  std::vector<PetscInt> held_;
+  std::vector<int> slot_;
+  std::vector<double> u_, u_committed_;  // the held nodes' displacement (3 per node, held_ order)
   std::vector<double> u_before_;         // the commit before u_committed_ (newton.extrapolate)
   double before_time_ = 0.0;
   MatrixSlots slots_;              // where the local elements' tangents go in K_ (found by create_matrix_)

@@ -141,6 +141,7 @@ class SolidRunner : public participant::SolidParticipant {
   // artery outputs (empty without an artery)
   LumenProfile lumen_;
   std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner (by node)
+  std::vector<int> lumen_nodes_;          // the lumen profile's nodes (held on every rank)
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
   std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
   // The last converged solve of the step (pseudo-time and sample points) and of the last committed

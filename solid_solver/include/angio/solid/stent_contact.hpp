@@ -94,7 +94,8 @@ class PenaltyStentContact : public StentContact {
   // With averaged normals a point's tangent couples its face's nodes with the rings of their normals
   // (the nodes of the faces around each); without, it stays within the face (an element's pattern).
   std::vector<NodeCoupling> couplings(const SolidModel& model) const override;
-  void load_levels(double t, std::vector<double>& out) const override;  // 1 or 0 per surface: on at t
+  std::vector<int> held_nodes(const SolidModel&) const override { return nodes_; }  // its surfaces'
+  void load_levels(double t, std::vector<double>& out) const override;              // 1 or 0 per surface: on at t
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
@@ -127,7 +128,8 @@ class PenaltyStentContact : public StentContact {
   // Per surface: its search tree was built for the current points' solve; later evaluations refit it
   // (same result; the tree's shape only decides how fast it answers).
   std::vector<char> built_;
-  std::vector<contact::Vec3> coords_;
+  std::vector<int> nodes_;             // its surfaces' nodes, ascending: the positions it reads
+  std::vector<contact::Vec3> coords_;  // by node, NaN but at nodes_
   // The last add()'s evaluation when it covered every point and surface (one rank, every pair on), and
   // the coordinates it saw: fill_reply() at the same configuration (a converged Newton's last residual)
   // takes it instead of evaluating again. Dropped by set_points().
@@ -158,6 +160,7 @@ class PenaltySurfaceContact : public ContactModel {
   std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
   void load_levels(double t, std::vector<double>& out) const override { out.push_back(t >= opt_.from); }  // on at t
+  std::vector<int> held_nodes(const SolidModel&) const override { return nodes_; }                        // its faces'
 
   const ContactSummary& last() const { return last_; }
   double active_area() const { return active_area_; }
@@ -169,6 +172,7 @@ class PenaltySurfaceContact : public ContactModel {
   std::unique_ptr<contact::SurfaceSearch> ss_, sm_;
   // Collective: contact at the current configuration into evaluated_ (this rank's pairs) and last_.
   void evaluate_(const SolidModel& model, bool tangent);
+  std::vector<int> nodes_;  // of the master's faces and of the slave's this rank evaluates
   std::vector<contact::Vec3> coords_;
   contact::SurfaceContactResult evaluated_;
   bool evaluated_tangent_ = false;
@@ -187,6 +191,7 @@ class CompositeContact : public StentContact {
   void set_points(const participant::SamplePoints& points) override;
   void add(const SolidModel& model, Vec r, Mat K) override;
   std::vector<NodeCoupling> couplings(const SolidModel& model) const override;        // of all its models
+  std::vector<int> held_nodes(const SolidModel& model) const override;                // of all its models
   std::vector<NodeCoupling> prepare(const SolidModel& model, bool tangent) override;  // of all its models
   void load_levels(double t, std::vector<double>& out) const override;                // of all its models
   bool extrapolates(double from, double to) const override;                           // all its models
