@@ -525,7 +525,7 @@ Vec3d SolidModel::displacement(int node) const {
   if (slot_[node] < 0)
     throw std::out_of_range("solid model: rank " + std::to_string(rank_) + " does not hold node " +
                             std::to_string(node));
-  const int p = 3 * slot_[node];
+  const int p = ldof_(node, 0);
   return Vec3d(u_[p], u_[p + 1], u_[p + 2]);
 }
 

@@ -6,7 +6,6 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
-#include <map>
 #include <sstream>
 
 #include <sys/resource.h>
@@ -328,18 +327,21 @@ void SolidRunner::nodal_stress_(StepSummary& s) const {
 
 void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_pressure) {
   const auto& mesh = model_->mesh();
-  // maximum displacement per part (the prestressed state: paper 0.14 mm), over each rank's elements
-  const std::vector<std::string> parts = part_names(mesh);
+  // maximum displacement per part (the prestressed state: paper 0.14 mm), over each rank's elements,
+  // reported in the order of the parts' names
+  std::vector<std::string> parts = part_names(mesh);
+  std::sort(parts.begin(), parts.end());
+  std::vector<std::size_t> part_of(mesh.blocks.size());
+  for (std::size_t b = 0; b < part_of.size(); ++b)
+    part_of[b] = std::size_t(std::find(parts.begin(), parts.end(), mesh.blocks[b].part) - parts.begin());
   std::vector<double> umax(parts.size(), 0.0), all(parts.size(), 0.0);
   for (int e : model_->local_elements()) {
     const auto& el = mesh.elements[e];
-    double& m = umax[std::find(parts.begin(), parts.end(), mesh.blocks[el.block].part) - parts.begin()];
-    for (int a = 0; a < el.nn(); ++a) m = std::max(m, model_->displacement(el.n[a]).norm());
+    for (int a = 0; a < el.nn(); ++a)
+      umax[part_of[el.block]] = std::max(umax[part_of[el.block]], model_->displacement(el.n[a]).norm());
   }
   MPI_Allreduce(umax.data(), all.data(), int(parts.size()), MPI_DOUBLE, MPI_MAX, comm_);
-  std::map<std::string, double> by_name;  // in the order of the parts' names
-  for (size_t k = 0; k < parts.size(); ++k) by_name[parts[k]] = all[k];
-  for (const auto& [part, u] : by_name) s.max_displacement.emplace_back(part, u);
+  for (std::size_t k = 0; k < parts.size(); ++k) s.max_displacement.emplace_back(parts[k], all[k]);
   if (lumen_.empty()) return;
   std::vector<Vec3d> x(mesh.X.size(), Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (int n : lumen_nodes_) x[n] = model_->position(n);  // held: the lumen's diameters read these

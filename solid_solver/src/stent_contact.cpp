@@ -35,11 +35,10 @@ bool same_positions(const SolidModel& model, const std::vector<int>& nodes, cons
 }
 
 // The nodes of the surfaces' faces, ascending.
-std::vector<int> face_nodes(std::initializer_list<const contact::Surface*> surfaces) {
+std::vector<int> face_nodes(std::span<const contact::Surface* const> surfaces) {
   std::vector<int> nodes;
   for (const contact::Surface* s : surfaces)
-    if (s)
-      for (const auto& f : s->faces) nodes.insert(nodes.end(), f.nodes.begin(), f.nodes.begin() + f.nn());
+    for (const auto& f : s->faces) nodes.insert(nodes.end(), f.nodes.begin(), f.nodes.begin() + f.nn());
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   return nodes;
@@ -126,12 +125,9 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
   };
   add_surface(opt_.balloon_surface, opt_.balloon_penalty, opt_.balloon_from);
   add_surface(opt_.artery_surface, opt_.artery_penalty, opt_.artery_from);
-  for (const auto& sf : surfaces_) {
-    const std::vector<int> n = face_nodes({sf.get()});
-    nodes_.insert(nodes_.end(), n.begin(), n.end());
-  }
-  std::sort(nodes_.begin(), nodes_.end());
-  nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
+  std::vector<const contact::Surface*> surfaces;
+  for (const auto& sf : surfaces_) surfaces.push_back(sf.get());
+  nodes_ = face_nodes(surfaces);
   last_.min_gap = opt_.search_radius;
 }
 
@@ -295,7 +291,8 @@ PenaltySurfaceContact::PenaltySurfaceContact(const SolidModel& model, Options op
   }
   if (!slave_->faces.empty()) ss_ = std::make_unique<contact::SurfaceSearch>(*slave_, opt_.search_radius);
   sm_ = std::make_unique<contact::SurfaceSearch>(*master_, opt_.search_radius);
-  nodes_ = face_nodes({slave_.get(), master_.get()});  // this rank's slice of the slave's, with one pass
+  const contact::Surface* both[] = {slave_.get(), master_.get()};
+  nodes_ = face_nodes(both);  // this rank's slice of the slave's, with one pass
   last_.min_gap = opt_.search_radius;
 }
 
@@ -377,10 +374,10 @@ void CompositeContact::add(const SolidModel& model, Vec r, Mat K) {
 }
 
 namespace {
-// The couplings `of` each model returns, the stent's first, concatenated.
+// What `of` returns for each model (couplings, nodes), the stent's first, concatenated.
 template <class Of>
-std::vector<NodeCoupling> all_couplings(ContactModel* stent, const std::vector<ContactModel*>& others, Of of) {
-  std::vector<NodeCoupling> out = stent ? of(*stent) : std::vector<NodeCoupling>{};
+auto all_of(ContactModel* stent, const std::vector<ContactModel*>& others, Of of) {
+  decltype(of(*stent)) out = stent ? of(*stent) : decltype(of(*stent)){};
   for (auto* m : others) {
     auto c = of(*m);
     out.insert(out.end(), std::make_move_iterator(c.begin()), std::make_move_iterator(c.end()));
@@ -390,20 +387,15 @@ std::vector<NodeCoupling> all_couplings(ContactModel* stent, const std::vector<C
 }  // namespace
 
 std::vector<NodeCoupling> CompositeContact::couplings(const SolidModel& model) const {
-  return all_couplings(stent_, others_, [&](ContactModel& m) { return m.couplings(model); });
+  return all_of(stent_, others_, [&](ContactModel& m) { return m.couplings(model); });
 }
 
 std::vector<int> CompositeContact::held_nodes(const SolidModel& model) const {
-  std::vector<int> out = stent_ ? stent_->held_nodes(model) : std::vector<int>{};
-  for (auto* m : others_) {
-    const std::vector<int> n = m->held_nodes(model);
-    out.insert(out.end(), n.begin(), n.end());
-  }
-  return out;
+  return all_of(stent_, others_, [&](ContactModel& m) { return m.held_nodes(model); });
 }
 
 std::vector<NodeCoupling> CompositeContact::prepare(const SolidModel& model, bool tangent) {
-  return all_couplings(stent_, others_, [&](ContactModel& m) { return m.prepare(model, tangent); });
+  return all_of(stent_, others_, [&](ContactModel& m) { return m.prepare(model, tangent); });
 }
 
 void CompositeContact::load_levels(double t, std::vector<double>& out) const {

@@ -135,6 +135,48 @@ std::unique_ptr<SolidModel> pressed_cube(const Mesh& m, const LayerMaterial& mat
 }
 }  // namespace
 
+// Nodes a rank holds only from a later hold_nodes() (a contact surface set after a continued run's
+// state was applied) take their owners' current and committed displacement: consistency of the held
+// state across ranks (on 2 ranks each rank holds fewer nodes than the mesh before).
+TEST(Model, NodesHeldLaterTakeTheirOwnersDisplacement) {
+  const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 4, 0.08, 5);
+  SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {1.0, 0.3}, {}}}, direct_options());
+  auto field = [&](double s) {  // a different displacement per node and per s
+    std::vector<Vec3d> u(m.X.size());
+    for (size_t n = 0; n < u.size(); ++n)
+      u[n] = s * Vec3d(0.01 * m.X[n].y(), 0.001 * double(n) - 0.02 * m.X[n].z(), 0.03 * m.X[n].x());
+    return u;
+  };
+  model.start_from(0.5, field(2.0), field(1.0), 0.25);  // committed field(2), the commit before field(1)
+  model.set_displacement(field(3.0));                   // current, on the nodes held so far
+  const int held_before = model.num_held_nodes();
+  int size = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  if (size > 1) {
+    EXPECT_LT(held_before, int(m.X.size()));
+  }
+  std::vector<int> all(m.X.size());
+  std::iota(all.begin(), all.end(), 0);
+  model.hold_nodes(all);
+  ASSERT_EQ(model.num_held_nodes(), int(m.X.size()));
+  const std::vector<Vec3d> current = field(3.0), committed = field(2.0), before = field(1.0);
+  double d = 0.0;
+  for (size_t n = 0; n < m.X.size(); ++n) d = std::max(d, (model.displacement(int(n)) - current[n]).norm());
+  EXPECT_EQ(d, 0.0);
+  std::vector<Vec3d> c, b;
+  double before_time = 0.0;
+  ASSERT_TRUE(model.gather_committed(c, b, before_time));
+  if (world_rank() == 0) {
+    EXPECT_EQ(max_diff(c, committed), 0.0);
+    EXPECT_EQ(max_diff(b, before), 0.0);
+    EXPECT_EQ(before_time, 0.25);
+  }
+  model.rollback();  // the committed state of the newly held nodes too
+  d = 0.0;
+  for (size_t n = 0; n < m.X.size(); ++n) d = std::max(d, (model.displacement(int(n)) - committed[n]).norm());
+  EXPECT_EQ(d, 0.0);
+}
+
 // Patch test through the whole distributed path: boundary nodes prescribed to the homogeneous
 // finite deformation u = G X (Dirichlet); the interior nodes must follow it exactly.
 TEST(Model, PatchTestSolveAllElementTypes) {
@@ -166,46 +208,6 @@ TEST(Model, PatchTestSolveAllElementTypes) {
 // MatSetValues gives, entry for entry and bit for bit (the same sums in the same order), on a deformed
 // distorted cube with a follower pressure; on 2 ranks the element graph's partition puts entries in
 // the off-diagonal block and rows on the other rank. Consistency: two insertion paths, one matrix.
-// Nodes a rank holds only from a later hold_nodes() (a contact surface set after a continued run's
-// state was applied) take their owners' current and committed displacement: consistency of the held
-// state across ranks (on 2 ranks each rank holds fewer nodes than the mesh before).
-TEST(Model, NodesHeldLaterTakeTheirOwnersDisplacement) {
-  const Mesh m = angio_test::cube_mesh(ElemType::Hex8, 4, 0.08, 5);
-  SolidModel model(PETSC_COMM_WORLD, m, {LayerMaterial{"cube", {1.0, 0.3}, {}}}, direct_options());
-  auto field = [&](double s) {  // a different displacement per node and per s
-    std::vector<Vec3d> u(m.X.size());
-    for (size_t n = 0; n < u.size(); ++n)
-      u[n] = s * Vec3d(0.01 * m.X[n].y(), 0.001 * double(n) - 0.02 * m.X[n].z(), 0.03 * m.X[n].x());
-    return u;
-  };
-  model.start_from(0.5, field(2.0), field(1.0), 0.25);  // committed field(2), the commit before field(1)
-  model.set_displacement(field(3.0));                   // current, on the nodes held so far
-  const int held_before = model.num_held_nodes();
-  int size = 1;
-  MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  if (size > 1) EXPECT_LT(held_before, int(m.X.size()));
-  std::vector<int> all(m.X.size());
-  std::iota(all.begin(), all.end(), 0);
-  model.hold_nodes(all);
-  ASSERT_EQ(model.num_held_nodes(), int(m.X.size()));
-  const std::vector<Vec3d> current = field(3.0), committed = field(2.0), before = field(1.0);
-  double d = 0.0;
-  for (size_t n = 0; n < m.X.size(); ++n) d = std::max(d, (model.displacement(int(n)) - current[n]).norm());
-  EXPECT_EQ(d, 0.0);
-  std::vector<Vec3d> c, b;
-  double before_time = 0.0;
-  ASSERT_TRUE(model.gather_committed(c, b, before_time));
-  if (world_rank() == 0) {
-    EXPECT_EQ(max_diff(c, committed), 0.0);
-    EXPECT_EQ(max_diff(b, before), 0.0);
-    EXPECT_EQ(before_time, 0.25);
-  }
-  model.rollback();  // the committed state of the newly held nodes too
-  d = 0.0;
-  for (size_t n = 0; n < m.X.size(); ++n) d = std::max(d, (model.displacement(int(n)) - committed[n]).norm());
-  EXPECT_EQ(d, 0.0);
-}
-
 TEST(Model, DirectInsertionGivesTheMatrixOfMatSetValues) {
   for (ElemType t : {ElemType::Hex8, ElemType::Tet10}) {
     Mesh m = angio_test::cube_mesh(t, 4, 0.08, 5);
