@@ -105,6 +105,7 @@ def row_of(name, run_dir, rc, wall, rss):
         "solid_s": c.get("solid_time"),
         "solid_assembly_s": t.get("assembly_seconds"),
         "solid_contact_s": t.get("contact_seconds"),
+        "solid_contact_reply_s": t.get("contact_reply_seconds"),
         "solid_linear_s": t.get("linear_seconds"),
         "beam_s": c.get("beam_time"),
         "messaging_s": c.get("messaging_time"),

@@ -93,6 +93,25 @@ void slice(std::size_t n, int rank, int size, std::size_t& lo, std::size_t& hi) 
   hi = n * std::size_t(rank + 1) / std::size_t(size);
 }
 
+// Every rank's slice of n items (`record` doubles each, this rank's in `mine`) in item order on rank 0;
+// empty on the other ranks. Collective.
+std::vector<double> gather_slices(const SolidModel& model, std::size_t n, std::size_t record,
+                                  const std::vector<double>& mine) {
+  const int size = model.size();
+  if (size == 1) return mine;
+  std::vector<int> counts(size), displs(size);
+  for (int r = 0; r < size; ++r) {
+    std::size_t lo, hi;
+    slice(n, r, size, lo, hi);
+    counts[r] = int(record * (hi - lo));
+    displs[r] = int(record * lo);
+  }
+  std::vector<double> all(model.rank() == 0 ? n * record : 0);
+  MPI_Gatherv(mine.data(), int(mine.size()), MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0,
+              model.comm());
+  return all;
+}
+
 }  // namespace
 
 contact::Surface to_contact_surface(const SurfaceSet& s, double normal_sign) {
@@ -192,7 +211,7 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   }
   last_ = reduce_summary(diag, 0.0, opt_.search_radius, model.comm(), nullptr);
   last_eval_.clear();
-  if (hi - lo == points_.size() && per_surface.size() == searches_.size()) {
+  if (per_surface.size() == searches_.size()) {  // every pair on: the reply's evaluation of this slice
     last_eval_ = std::move(per_surface);
     std::swap(last_eval_coords_, coords_);  // no copy: the next evaluation gathers coords_ anew
   }
@@ -224,35 +243,57 @@ void PenaltyStentContact::fill_reply(const SolidModel& model, participant::Conta
   reply.n_active = 0;
   reply.min_gap = opt_.search_radius;
   reply.total_force = {0.0, 0.0, 0.0};
-  // every rank: identical data, no communication; the last assembly's when it saw this configuration
+  const size_t K = searches_.size();
+  if (n == 0 || K == 0) return;
+  // Each rank evaluates its slice of the points (the last assembly's evaluation when it saw this
+  // configuration: a converged Newton's last residual), rank 0 gathers them: per point the line load
+  // q and, per surface, whether it has a plane, whether the point is active, the plane's point and
+  // normal and the gap.
+  std::size_t lo, hi;
+  slice(n, model.rank(), model.size(), lo, hi);
   const bool reuse = !last_eval_.empty() && same_positions(model, nodes_, last_eval_coords_);
-  const auto per_surface = reuse ? std::move(last_eval_) : evaluate_(model, points_, 0, false, true);
+  const auto per_surface =
+      reuse ? std::move(last_eval_) : evaluate_(model, std::span(points_).subspan(lo, hi - lo), lo, false, true);
   last_eval_.clear();
-  if (per_surface.empty()) return;
+  constexpr size_t kPerSurface = 9;
+  const size_t record = 3 + kPerSurface * K;
+  std::vector<double> mine;
+  mine.reserve(record * (hi - lo));
+  for (size_t i = 0; i < hi - lo; ++i) {
+    contact::Vec3 q = contact::Vec3::Zero();
+    for (size_t k = 0; k < K; ++k) q += per_surface[k].q[i];
+    mine.insert(mine.end(), {q(0), q(1), q(2)});
+    for (size_t k = 0; k < K; ++k) {
+      const auto& pc = per_surface[k].per_surface[0][i];
+      const bool plane = pc.found && on_(k, model);  // no plane (eps 0) where the pair is off
+      mine.insert(mine.end(), {double(plane), double(plane && pc.active), pc.proj.s(0), pc.proj.s(1), pc.proj.s(2),
+                               pc.proj.n(0), pc.proj.n(1), pc.proj.n(2), pc.gap});
+    }
+  }
+  const std::vector<double> all = gather_slices(model, n, record, mine);
+  if (model.rank() != 0) return;
   // robin data: one plane per point and surface (K = number of surfaces, point-major), eps = 0 where
   // the surface has no face within the search radius
-  const size_t K = per_surface.size();
   reply.surface_points.assign(K * n, {0.0, 0.0, 0.0});
   reply.normals.assign(K * n, {0.0, 0.0, 0.0});
   reply.penalty.assign(K * n, 0.0);
   reply.regularization = opt_.regularization;
   for (size_t i = 0; i < n; ++i) {
-    contact::Vec3 q = contact::Vec3::Zero();
+    const double* p = all.data() + i * record;
     bool active = false;
     for (size_t k = 0; k < K; ++k) {
-      q += per_surface[k].q[i];
-      const auto& pc = per_surface[k].per_surface[0][i];
+      const double* c = p + 3 + kPerSurface * k;
       const size_t j = i * K + k;
       reply.surface_points[j] = {points_[i].x(0), points_[i].x(1), points_[i].x(2)};
-      if (!pc.found || !on_(k, model)) continue;  // no plane (eps 0) where the pair is off
-      active = active || pc.active;
-      reply.surface_points[j] = {pc.proj.s(0), pc.proj.s(1), pc.proj.s(2)};
-      reply.normals[j] = {pc.proj.n(0), pc.proj.n(1), pc.proj.n(2)};
+      if (c[0] == 0.0) continue;
+      active = active || c[1] != 0.0;
+      reply.surface_points[j] = {c[2], c[3], c[4]};
+      reply.normals[j] = {c[5], c[6], c[7]};
       reply.penalty[j] = penalty_[k];
-      reply.min_gap = std::min(reply.min_gap, pc.gap);
+      reply.min_gap = std::min(reply.min_gap, c[8]);
     }
-    reply.line_loads[i] = {q(0), q(1), q(2)};
-    for (int c = 0; c < 3; ++c) reply.total_force[c] += points_[i].w * q(c);
+    reply.line_loads[i] = {p[0], p[1], p[2]};
+    for (int c = 0; c < 3; ++c) reply.total_force[c] += points_[i].w * p[c];
     reply.active[i] = active ? 1 : 0;
     reply.n_active += active ? 1 : 0;
   }
@@ -264,12 +305,17 @@ void PenaltyStentContact::gaps(const SolidModel& model, const std::string& surfa
   weight.clear();
   const auto it = std::find(names_.begin(), names_.end(), surface);
   if (it == names_.end() || points_.empty()) return;
-  const auto per_surface = evaluate_(model, points_, 0, false, true);  // every rank: identical data, no communication
-  const auto& pcs = per_surface[it - names_.begin()].per_surface[0];
-  for (size_t i = 0; i < points_.size(); ++i) {
-    gap.push_back(pcs[i].found ? pcs[i].gap : std::numeric_limits<double>::infinity());
-    weight.push_back(points_[i].w);
+  std::size_t lo, hi;  // each rank its slice, gathered on rank 0
+  slice(points_.size(), model.rank(), model.size(), lo, hi);
+  const auto per_surface = evaluate_(model, std::span(points_).subspan(lo, hi - lo), lo, false, true);
+  std::vector<double> mine(hi - lo);
+  for (size_t i = 0; i < hi - lo; ++i) {
+    const auto& pc = per_surface[it - names_.begin()].per_surface[0][i];
+    mine[i] = pc.found ? pc.gap : std::numeric_limits<double>::infinity();
   }
+  gap = gather_slices(model, points_.size(), 1, mine);
+  if (model.rank() == 0)
+    for (const auto& p : points_) weight.push_back(p.w);
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -25,10 +25,13 @@ namespace angio::solid {
 class StentContact : public ContactModel {
  public:
   virtual void set_points(const participant::SamplePoints& points) = 0;
+  // The contact of the current state for the reply to the beam, complete on rank 0 (the rank that
+  // answers the coupler); the other ranks' reply is left as given. Collective.
   virtual void fill_reply(const SolidModel& model, participant::ContactReply& reply) = 0;
   // Gap of every sample point of set_points() to the surface set `surface` at the current state
   // (mm, g = (x − s)·n − R; +∞ where no face lies within the search radius), and the points'
-  // arc-length weights; both empty if this contact does not involve that surface. Every rank.
+  // arc-length weights; both empty if this contact does not involve that surface, and on every rank
+  // but 0. Collective.
   virtual void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
                     std::vector<double>& weight) {
     (void)model, (void)surface;
@@ -126,6 +129,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
   double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
   double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (on rank 0): max, p99, ball average
+  double reply_seconds_ = 0.0;  // the stent contact's replies and per-step gaps outside the solves (rank 0)
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;

@@ -9,12 +9,14 @@
 //  * CompositeContact: the StentContact registered with SolidRunner (SolidModel holds one ContactModel
 //    pointer); forwards add() to both and the reply to the stent part.
 //
-// MPI: every rank holds the full displacement, so every rank builds the searches over the WHOLE surfaces (no
-// artificial free edges at partition boundaries) and evaluates a contiguous slice of the beam points / of the
-// slave faces (two_pass: rank 0 evaluates everything); each rank adds its own contributions (ADD_VALUES,
-// communicated by the model's assembly), so every contribution enters the global system exactly once.
-// add() is collective (Allreduce of the diagnostics); fill_reply() evaluates all points on every rank
-// (identical data, no communication).
+// MPI: every rank holds the displacement of the surfaces' nodes (held_nodes), so every rank builds the searches
+// over the WHOLE surfaces (no artificial free edges at partition boundaries) and evaluates a contiguous slice
+// of the beam points / of the slave faces (two_pass: rank 0 evaluates everything); each rank adds its own
+// contributions (ADD_VALUES, communicated by the model's assembly), so every contribution enters the global
+// system exactly once.
+// add() is collective (Allreduce of the diagnostics); fill_reply() and gaps() evaluate each rank's slice of
+// the points (fill_reply: the last add()'s evaluation when it saw the same configuration) and gather them on
+// rank 0, which answers the coupler.
 // Units: mm, N, MPa.
 #pragma once
 #include <cstdint>
@@ -130,7 +132,7 @@ class PenaltyStentContact : public StentContact {
   std::vector<char> built_;
   std::vector<int> nodes_;             // its surfaces' nodes, ascending: the positions it reads
   std::vector<contact::Vec3> coords_;  // by node, NaN but at nodes_
-  // The last add()'s evaluation when it covered every point and surface (one rank, every pair on), and
+  // The last add()'s evaluation of this rank's slice when it covered every surface (every pair on), and
   // the coordinates it saw: fill_reply() at the same configuration (a converged Newton's last residual)
   // takes it instead of evaluating again. Dropped by set_points().
   std::vector<contact::LineContactResult> last_eval_;
