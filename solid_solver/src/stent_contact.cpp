@@ -18,41 +18,55 @@ namespace angio::solid {
 
 namespace {
 
-// The current positions of `nodes` (the contact's surfaces' nodes, which the model holds on every
-// rank) into coords, indexed by node as the surfaces' faces are; the other entries stay NaN.
+// The current positions of the contact's nodes (its own numbering: contact node i is mesh node nodes[i],
+// which the model holds on every rank).
 void gather_coords(const SolidModel& model, const std::vector<int>& nodes, std::vector<contact::Vec3>& coords) {
-  if (coords.size() != model.mesh().X.size())
-    coords.assign(model.mesh().X.size(), contact::Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
-  for (int n : nodes) coords[n] = model.position(n);
+  coords.resize(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i) coords[i] = model.position(nodes[i]);
 }
 
 // Whether the model's positions of `nodes` are bit for bit `coords` (the configuration an evaluation saw).
 bool same_positions(const SolidModel& model, const std::vector<int>& nodes, const std::vector<contact::Vec3>& coords) {
-  if (coords.size() != model.mesh().X.size()) return false;
-  for (int n : nodes)
-    if (coords[n] != model.position(n)) return false;
+  if (coords.size() != nodes.size()) return false;
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (coords[i] != model.position(nodes[i])) return false;
   return true;
 }
 
-// The nodes of the surfaces' faces, ascending.
-std::vector<int> face_nodes(std::span<const contact::Surface* const> surfaces) {
+// Renumbers the surfaces' faces to the contact's own node numbering and returns the mesh node of each
+// contact node (ascending, so the numbering keeps the mesh's order): the coordinate arrays, the nodal
+// normals and the searches then hold the surfaces' nodes, not the whole mesh's.
+std::vector<int> renumber(std::span<contact::Surface* const> surfaces) {
   std::vector<int> nodes;
   for (const contact::Surface* s : surfaces)
     for (const auto& f : s->faces) nodes.insert(nodes.end(), f.nodes.begin(), f.nodes.begin() + f.nn());
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  for (contact::Surface* s : surfaces)
+    for (auto& f : s->faces)
+      for (int a = 0; a < f.nn(); ++a)
+        f.nodes[a] = int(std::lower_bound(nodes.begin(), nodes.end(), f.nodes[a]) - nodes.begin());
   return nodes;
 }
 
-// Adds contributions (r = dPi/dX on the first r.size()/3 nodes, K = dr/dX over all nodes) with the model's global
-// dof numbers. Eigen's column-major K goes in as is: the model's Mat is column-oriented.
-void insert(const SolidModel& model, const std::vector<contact::NodalContribution>& cs, Vec r, Mat K) {
+// The mesh nodes of contact nodes `ids`.
+std::vector<int> mesh_nodes(const std::vector<int>& nodes, std::span<const int> ids) {
+  std::vector<int> out(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) out[i] = nodes[ids[i]];
+  return out;
+}
+
+// Adds contributions (r = dPi/dX on the first r.size()/3 nodes, K = dr/dX over all nodes; their nodes in the
+// contact's numbering, mesh node nodes[i]) with the model's global dof numbers. Eigen's column-major K goes in
+// as is: the model's Mat is column-oriented.
+void insert(const SolidModel& model, const std::vector<int>& nodes, const std::vector<contact::NodalContribution>& cs,
+            Vec r, Mat K) {
   std::vector<PetscInt> idx;
   for (const auto& c : cs) {
     const int rows = int(c.r.size()), m = 3 * int(c.nodes.size());
     idx.resize(m);
     for (size_t a = 0; a < c.nodes.size(); ++a)
-      for (int k = 0; k < 3; ++k) idx[3 * a + k] = model.dof(c.nodes[a], k);
+      for (int k = 0; k < 3; ++k) idx[3 * a + k] = model.dof(nodes[c.nodes[a]], k);
     ANGIO_PETSC(VecSetValues(r, rows, idx.data(), c.r.data(), ADD_VALUES));
     if (K && c.K.size() > 0) {
       if (c.K.rows() != rows || c.K.cols() != m) throw std::logic_error("contact contribution: tangent size mismatch");
@@ -136,17 +150,19 @@ PenaltyStentContact::PenaltyStentContact(const SolidModel& model, Options opt) :
     const SurfaceSet* s = model.mesh().surface(name);
     if (!s || s->faces.empty()) return;
     surfaces_.push_back(std::make_unique<contact::Surface>(to_contact_surface(*s, +1.0)));
-    searches_.push_back(std::make_unique<contact::SurfaceSearch>(*surfaces_.back(), opt_.search_radius));
-    searches_.back()->enable_normal_field(opt_.averaged_normals);
     names_.push_back(name);
     penalty_.push_back(*eps);
     from_.push_back(from);
   };
   add_surface(opt_.balloon_surface, opt_.balloon_penalty, opt_.balloon_from);
   add_surface(opt_.artery_surface, opt_.artery_penalty, opt_.artery_from);
-  std::vector<const contact::Surface*> surfaces;
+  std::vector<contact::Surface*> surfaces;
   for (const auto& sf : surfaces_) surfaces.push_back(sf.get());
-  nodes_ = face_nodes(surfaces);
+  nodes_ = renumber(surfaces);  // before the searches, which key the free edges by node
+  for (const auto& sf : surfaces_) {
+    searches_.push_back(std::make_unique<contact::SurfaceSearch>(*sf, opt_.search_radius));
+    searches_.back()->enable_normal_field(opt_.averaged_normals);
+  }
   last_.min_gap = opt_.search_radius;
 }
 
@@ -205,7 +221,7 @@ void PenaltyStentContact::add(const SolidModel& model, Vec r, Mat K) {
   contact::ContactDiagnostics diag;
   auto per_surface = evaluate_(model, std::span(points_).subspan(lo, hi - lo), lo, K != nullptr, false);
   for (auto& res : per_surface) {
-    insert(model, res.solid, r, K);
+    insert(model, nodes_, res.solid, r, K);
     diag.merge(res.diag);
     res.solid.clear();  // the reply needs the points' results only
   }
@@ -223,11 +239,14 @@ std::vector<NodeCoupling> PenaltyStentContact::couplings(const SolidModel& model
   std::vector<NodeCoupling> out;
   if (!opt_.averaged_normals || !opt_.ring_tangent) return out;  // face columns: the elements' pattern has them
   for (const auto& surface : surfaces_) {
-    const auto ring = contact::node_rings(*surface, model.mesh().X.size());
+    const auto ring = contact::node_rings(*surface, nodes_.size());
     for (const auto& f : surface->faces) {
       NodeCoupling c;
-      c.rows.assign(f.nodes.begin(), f.nodes.begin() + f.nn());
-      for (int a = 0; a < f.nn(); ++a) c.cols.insert(c.cols.end(), ring[f.nodes[a]].begin(), ring[f.nodes[a]].end());
+      c.rows = mesh_nodes(nodes_, std::span(f.nodes).first(f.nn()));
+      for (int a = 0; a < f.nn(); ++a) {
+        const auto cols = mesh_nodes(nodes_, ring[f.nodes[a]]);
+        c.cols.insert(c.cols.end(), cols.begin(), cols.end());
+      }
       std::sort(c.cols.begin(), c.cols.end());
       c.cols.erase(std::unique(c.cols.begin(), c.cols.end()), c.cols.end());
       out.push_back(std::move(c));
@@ -335,10 +354,10 @@ PenaltySurfaceContact::PenaltySurfaceContact(const SolidModel& model, Options op
     slice(slave_->faces.size(), model.rank(), model.size(), lo, hi);
     slave_->faces = std::vector<contact::Face>(slave_->faces.begin() + lo, slave_->faces.begin() + hi);
   }
+  contact::Surface* both[] = {slave_.get(), master_.get()};
+  nodes_ = renumber(both);  // this rank's slice of the slave's, with one pass; before the searches
   if (!slave_->faces.empty()) ss_ = std::make_unique<contact::SurfaceSearch>(*slave_, opt_.search_radius);
   sm_ = std::make_unique<contact::SurfaceSearch>(*master_, opt_.search_radius);
-  const contact::Surface* both[] = {slave_.get(), master_.get()};
-  nodes_ = face_nodes(both);  // this rank's slice of the slave's, with one pass
   last_.min_gap = opt_.search_radius;
 }
 
@@ -393,8 +412,9 @@ std::vector<NodeCoupling> PenaltySurfaceContact::prepare(const SolidModel& model
     if (!paired_.insert(key_of(gp)).second) continue;
     const contact::Face& fs = (gp.pass == 0 ? *slave_ : *master_).faces[gp.slave_face];
     const contact::Face& fm = (gp.pass == 0 ? *master_ : *slave_).faces[gp.master_face];
-    std::vector<int> nodes(fs.nodes.begin(), fs.nodes.begin() + fs.nn());
-    nodes.insert(nodes.end(), fm.nodes.begin(), fm.nodes.begin() + fm.nn());
+    std::vector<int> nodes = mesh_nodes(nodes_, std::span(fs.nodes).first(fs.nn()));
+    const std::vector<int> more = mesh_nodes(nodes_, std::span(fm.nodes).first(fm.nn()));
+    nodes.insert(nodes.end(), more.begin(), more.end());
     out.push_back({nodes, nodes});
   }
   return out;
@@ -405,7 +425,7 @@ void PenaltySurfaceContact::add(const SolidModel& model, Vec r, Mat K) {
   // (or one that needs the tangent prepare() did not compute) evaluates now
   if (!prepared_ || (K && !evaluated_tangent_)) evaluate_(model, K != nullptr);
   prepared_ = false;
-  insert(model, evaluated_.contributions, r, K);
+  insert(model, nodes_, evaluated_.contributions, r, K);
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -130,8 +130,10 @@ class PenaltyStentContact : public StentContact {
   // Per surface: its search tree was built for the current points' solve; later evaluations refit it
   // (same result; the tree's shape only decides how fast it answers).
   std::vector<char> built_;
-  std::vector<int> nodes_;             // its surfaces' nodes, ascending: the positions it reads
-  std::vector<contact::Vec3> coords_;  // by node, NaN but at nodes_
+  // Its surfaces' faces are numbered by contact node: node i is mesh node nodes_[i] (ascending), the
+  // positions it reads; coordinate arrays, nodal normals and searches hold these nodes only.
+  std::vector<int> nodes_;
+  std::vector<contact::Vec3> coords_;  // by contact node
   // The last add()'s evaluation of this rank's slice when it covered every surface (every pair on), and
   // the coordinates it saw: fill_reply() at the same configuration (a converged Newton's last residual)
   // takes it instead of evaluating again. Dropped by set_points().
@@ -174,8 +176,10 @@ class PenaltySurfaceContact : public ContactModel {
   std::unique_ptr<contact::SurfaceSearch> ss_, sm_;
   // Collective: contact at the current configuration into evaluated_ (this rank's pairs) and last_.
   void evaluate_(const SolidModel& model, bool tangent);
-  std::vector<int> nodes_;  // of the master's faces and of the slave's this rank evaluates
-  std::vector<contact::Vec3> coords_;
+  // of the master's faces and of the slave's this rank evaluates, ascending: contact node i (the faces'
+  // numbering) is mesh node nodes_[i]
+  std::vector<int> nodes_;
+  std::vector<contact::Vec3> coords_;  // by contact node
   contact::SurfaceContactResult evaluated_;
   bool evaluated_tangent_ = false;
   bool prepared_ = false;                     // evaluated_ is prepare()'s, for the add() that follows it
