@@ -1156,12 +1156,13 @@ std::vector<Vec3d> SolidModel::contact_forces(ContactModel& c) {
   c.add(*this, f, nullptr);
   ANGIO_PETSC(VecAssemblyBegin(f));
   ANGIO_PETSC(VecAssemblyEnd(f));
-  std::vector<double> held;
-  gather_(f, held);
+  // the owned rows, the owned nodes in order (block size 3)
+  std::vector<Vec3d> out(node_end_ - node_begin_);
+  const PetscScalar* a;
+  ANGIO_PETSC(VecGetArrayRead(f, &a));
+  for (size_t i = 0; i < out.size(); ++i) out[i] = -Vec3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]);  // r = f_int − f_ext
+  ANGIO_PETSC(VecRestoreArrayRead(f, &a));
   ANGIO_PETSC(VecDestroy(&f));
-  std::vector<Vec3d> out(mesh_.X.size(), Vec3d::Zero());
-  for (size_t i = 0; i < held_.size(); ++i)
-    for (int k = 0; k < 3; ++k) out[iperm_[held_[i]]](k) = -held[3 * i + k];  // residual r = f_int − f_ext
   return out;
 }
 

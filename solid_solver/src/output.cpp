@@ -194,8 +194,7 @@ std::vector<std::string> nodal_stress_field_names(const Mesh& mesh) {
 }
 
 void FieldWriter::write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir,
-                             const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal,
-                             const std::vector<std::pair<std::string, const std::vector<double>*>>& owned_nodal) {
+                             const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal) {
   const std::string g = "/steps/" + std::to_string(step);
   const long n0 = model_.owned_node_begin(), n1 = model_.owned_node_end(), N = long(model_.mesh().X.size());
   std::vector<double> u(3 * (n1 - n0));
@@ -206,14 +205,8 @@ void FieldWriter::write_step(int step, double time, const std::vector<double>& p
   write_rows(file_, g + "/displacement", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, u.data());
   StepInfo info{step, time, {}};
   for (const auto& [field, values] : nodal) {
-    std::vector<double> v(n1 - n0);
-    for (long i = n0; i < n1; ++i) v[i - n0] = (*values)[model_.old_index(int(i))];
-    write_rows(file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, v.data());
-    info.nodal.push_back(field);
-  }
-  for (const auto& [field, values] : owned_nodal) {
     if (long(values->size()) != n1 - n0)
-      throw std::invalid_argument("write_step: owned nodal field " + field + " has " + std::to_string(values->size()) +
+      throw std::invalid_argument("write_step: nodal field " + field + " has " + std::to_string(values->size()) +
                                   " values for " + std::to_string(n1 - n0) + " owned nodes");
     write_rows(file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, values->data());
     info.nodal.push_back(field);

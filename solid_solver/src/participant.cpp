@@ -71,7 +71,11 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     std::vector<double> st(nodes.size());
     for (size_t i = 0; i < nodes.size(); ++i) st[i] = scene_.lumen->station(mesh.X[nodes[i]]);
     lumen_ = LumenProfile(nodes, st, scene_.lumen_max_stations);
-    endothelium_area_ = nodal_areas(mesh, *endo);
+    const std::vector<double> area = nodal_areas(mesh, *endo);  // by mesh node
+    const int n0 = model_->owned_node_begin();
+    endothelium_area_.resize(model_->owned_node_end() - n0);
+    for (std::size_t i = 0; i < endothelium_area_.size(); ++i)
+      endothelium_area_[i] = area[model_->old_index(n0 + int(i))];
     lumen_nodes_ = std::move(nodes);
   }
   // what the per-step measures read on every rank: the balloon's rings and the lumen
@@ -305,7 +309,7 @@ void SolidRunner::nodal_stress_(StepSummary& s) const {
   std::vector<double> mine;
   for (int i = 0; i < rec.num_owned(); ++i) {
     const int node = model_->old_index(n0 + i);
-    const double lumen = !endothelium_area_.empty() && endothelium_area_[node] > 0.0 ? 1.0 : 0.0;
+    const double lumen = !endothelium_area_.empty() && endothelium_area_[i] > 0.0 ? 1.0 : 0.0;
     const Vec3d x = model_->position(node);
     for (int b = 0; b < nb; ++b)
       if (rec.has(i, b)) mine.insert(mine.end(), {double(b), rec.p1(i, b), rec.weight(i, b), lumen, x(0), x(1), x(2)});
@@ -359,21 +363,27 @@ void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_
     }
     s.stent_stations = std::make_pair(lo, hi);
   }
-  // contact on the endothelium: force per contact model, and the pressure field of all of them
-  contact_pressure.assign(mesh.X.size(), 0.0);
-  std::vector<Vec3d> total(mesh.X.size(), Vec3d::Zero());
-  for (const auto& [name, c] : contact_reports_) {
-    const std::vector<Vec3d> f = model_->contact_forces(*c);
+  // contact on the endothelium: force per contact model (summed over each rank's owned nodes), and
+  // the pressure field of all of them at the owned nodes
+  const std::size_t owned = endothelium_area_.size();
+  contact_pressure.assign(owned, 0.0);
+  std::vector<Vec3d> total(owned, Vec3d::Zero());
+  std::vector<double> sums, summed(contact_reports_.size());
+  for (const auto& entry : contact_reports_) {
+    const std::vector<Vec3d> f = model_->contact_forces(*entry.second);
     double sum = 0.0;
-    for (size_t n = 0; n < f.size(); ++n)
-      if (endothelium_area_[n] > 0.0) {
-        sum += f[n].norm();
-        total[n] += f[n];
+    for (size_t i = 0; i < owned; ++i)
+      if (endothelium_area_[i] > 0.0) {
+        sum += f[i].norm();
+        total[i] += f[i];
       }
-    s.artery_contact_force.emplace_back(name, sum);
+    sums.push_back(sum);
   }
-  for (size_t n = 0; n < total.size(); ++n)
-    if (endothelium_area_[n] > 0.0) contact_pressure[n] = total[n].norm() / endothelium_area_[n];
+  MPI_Allreduce(sums.data(), summed.data(), int(sums.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  for (size_t k = 0; k < contact_reports_.size(); ++k)
+    s.artery_contact_force.emplace_back(contact_reports_[k].first, summed[k]);
+  for (size_t i = 0; i < owned; ++i)
+    if (endothelium_area_[i] > 0.0) contact_pressure[i] = total[i].norm() / endothelium_area_[i];
   if (stent_contact_) {
     std::vector<double> gap, weight;
     const double t_gaps = MPI_Wtime();
@@ -444,15 +454,14 @@ void SolidRunner::record_and_write_(int step, double time) {
   // starts where the fields end)
   const bool last = time >= scene_.time.end - 1e-12 * std::max(1.0, std::abs(scene_.time.end));
   if (writer_ && (step % scene_.output.every == 0 || step == 0 || last)) {
-    std::vector<std::pair<std::string, const std::vector<double>*>> nodal;
-    if (!contact_pressure.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);
+    std::vector<std::pair<std::string, const std::vector<double>*>> nodal;  // at the owned nodes
+    if (scene_.lumen && !lumen_.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);  // every rank
     std::vector<std::vector<double>> fields(recovery_->num_blocks());
-    std::vector<std::pair<std::string, const std::vector<double>*>> owned;
     for (int b = 0; b < recovery_->num_blocks(); ++b) {
       fields[b] = recovery_->p1_field(b);
-      owned.emplace_back(nodal_stress_names_[b], &fields[b]);
+      nodal.emplace_back(nodal_stress_names_[b], &fields[b]);
     }
-    writer_->write_step(step, time, p1, dir, nodal, owned);
+    writer_->write_step(step, time, p1, dir, nodal);
   }
   write_summary_();
 }

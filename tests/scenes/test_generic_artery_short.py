@@ -25,6 +25,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+import h5py
+import numpy as np
 import yaml
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -82,10 +84,16 @@ def run(scene_file, run_dir, ranks, bin_dir):
 
 
 def load(run_dir):
+    # the nodal contact pressure on the endothelium at the last written step, by the input mesh's node
+    with h5py.File(run_dir / "solid" / "solid.h5", "r") as f:
+        last = max(f["steps"], key=int)
+        pressure = np.empty(len(f["mesh/original_node_id"]))
+        pressure[f["mesh/original_node_id"][...]] = f["steps"][last]["contact_pressure"][...]
     return {
         "beam": json.loads((run_dir / "beam" / "summary.json").read_text()),
         "solid": json.loads((run_dir / "solid" / "summary.json").read_text()),
         "coupling": json.loads((run_dir / "coupling_summary.json").read_text()),
+        "contact_pressure": pressure,
     }
 
 
@@ -151,6 +159,12 @@ def main():
             f"{ranks} rank(s): part of the stent is apposed "
             f"(malapposed {100 * app['malapposed_fraction']:.1f} %, max gap {app['max_gap']:.3f} mm)",
         )
+        p = res["contact_pressure"]
+        check(
+            np.isfinite(p).all() and p.min() >= 0.0 and p.max() > 0.0,
+            f"{ranks} rank(s): the nodal contact pressure is finite, non-negative and somewhere positive "
+            f"(largest {p.max():.4g} MPa at t = {last['time']})",
+        )
         print(f"     balloon-artery contact force {last['artery_contact_force'].get('balloon', 0):.4g} N")
         for layer in ("media", "adventitia"):
             values = [s["max_principal_stress"][layer] for s in steps[1:]]
@@ -167,13 +181,18 @@ def main():
 
     if 1 in results and 2 in results:
         a, b = results[1], results[2]
-        worst = {"stent diameter": 0.0, "stress": 0.0}
+        worst = {"stent diameter": 0.0, "stress": 0.0, "artery contact force": 0.0}
         for sa, sb in zip(a["beam"]["steps"], b["beam"]["steps"]):
             worst["stent diameter"] = max(worst["stent diameter"], rel(sa["diameter"], sb["diameter"]))
         for sa, sb in zip(a["solid"]["steps"][1:], b["solid"]["steps"][1:]):
             for layer in ("media", "adventitia", "balloon"):
                 for key in ("max_principal_stress", "p99_principal_stress"):
                     worst["stress"] = max(worst["stress"], rel(sa[key][layer], sb[key][layer]))
+            for name in ("stent", "balloon"):
+                fa, fb = sa["artery_contact_force"][name], sb["artery_contact_force"][name]
+                worst["artery contact force"] = max(worst["artery contact force"], rel(fa, fb) if fa > 1e-9 else 0.0)
+        pa, pb = a["contact_pressure"], b["contact_pressure"]
+        worst["contact pressure field"] = float(np.abs(pa - pb).max() / pa.max())
         for k, v in worst.items():
             check(v < RANK_TOL, f"1 vs 2 ranks: largest relative difference of the {k} {v:.2e} < {RANK_TOL}")
         print(

@@ -288,8 +288,8 @@ class SolidModel {
   void element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir, std::vector<double>* volume = nullptr,
                       std::vector<Mat3>* gauss = nullptr) const;
   // Nodal forces that contact model c exerts on the solid at the current state (−its residual
-  // contribution), by original node index, at the nodes this rank holds (zero elsewhere: the contact
-  // model's own surfaces are held, ContactModel::held_nodes). Collective.
+  // contribution) at this rank's owned nodes: entry i for node owned_node_begin() + i (new numbering).
+  // Collective.
   std::vector<Vec3d> contact_forces(ContactModel& c);
   // Assemble residual (and tangent) at the current state; for tests. Returns false on invalid state.
   bool assemble(Vec r, Mat K);

@@ -45,12 +45,11 @@ class FieldWriter {
   FieldWriter(const SolidModel& model, const std::string& dir);  // collective
   ~FieldWriter();
   // Collective. p1/dir: per local element (model.local_elements() order), from element_stress().
-  // nodal: extra nodal scalar fields, each a full vector by original node index (same on all ranks).
-  // owned_nodal: nodal scalar fields given for this rank's owned nodes only (new numbering, entry i
-  // for node owned_node_begin() + i), e.g. the recovered stresses (nodal_stress_field_name).
+  // nodal: extra nodal scalar fields given for this rank's owned nodes (new numbering, entry i for
+  // node owned_node_begin() + i), e.g. the recovered stresses (nodal_stress_field_name), the contact
+  // pressure.
   void write_step(int step, double time, const std::vector<double>& p1, const std::vector<Vec3d>& dir,
-                  const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal = {},
-                  const std::vector<std::pair<std::string, const std::vector<double>*>>& owned_nodal = {});
+                  const std::vector<std::pair<std::string, const std::vector<double>*>>& nodal = {});
   void close();
 
  private:

@@ -144,7 +144,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<int> ring_mid_, ring_end0_, ring_end1_;
   // artery outputs (empty without an artery)
   LumenProfile lumen_;
-  std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner (by node)
+  std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner per owned node (0 off the lumen)
   std::vector<int> lumen_nodes_;          // the lumen profile's nodes (held on every rank)
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
   std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
