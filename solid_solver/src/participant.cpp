@@ -455,7 +455,8 @@ void SolidRunner::record_and_write_(int step, double time) {
   const bool last = time >= scene_.time.end - 1e-12 * std::max(1.0, std::abs(scene_.time.end));
   if (writer_ && (step % scene_.output.every == 0 || step == 0 || last)) {
     std::vector<std::pair<std::string, const std::vector<double>*>> nodal;  // at the owned nodes
-    if (scene_.lumen && !lumen_.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);  // every rank
+    // at every rank's owned nodes where artery_measures_ computed it (lumen_ is the same on all ranks)
+    if (!lumen_.empty()) nodal.emplace_back("contact_pressure", &contact_pressure);
     std::vector<std::vector<double>> fields(recovery_->num_blocks());
     for (int b = 0; b < recovery_->num_blocks(); ++b) {
       fields[b] = recovery_->p1_field(b);

@@ -49,11 +49,9 @@ std::vector<int> renumber(std::span<contact::Surface* const> surfaces) {
   return nodes;
 }
 
-// The mesh nodes of contact nodes `ids`.
-std::vector<int> mesh_nodes(const std::vector<int>& nodes, std::span<const int> ids) {
-  std::vector<int> out(ids.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) out[i] = nodes[ids[i]];
-  return out;
+// Appends the mesh nodes of contact nodes `ids` to out.
+void append_mesh_nodes(std::vector<int>& out, const std::vector<int>& nodes, std::span<const int> ids) {
+  for (int id : ids) out.push_back(nodes[id]);
 }
 
 // Adds contributions (r = dPi/dX on the first r.size()/3 nodes, K = dr/dX over all nodes; their nodes in the
@@ -242,11 +240,8 @@ std::vector<NodeCoupling> PenaltyStentContact::couplings(const SolidModel& model
     const auto ring = contact::node_rings(*surface, nodes_.size());
     for (const auto& f : surface->faces) {
       NodeCoupling c;
-      c.rows = mesh_nodes(nodes_, std::span(f.nodes).first(f.nn()));
-      for (int a = 0; a < f.nn(); ++a) {
-        const auto cols = mesh_nodes(nodes_, ring[f.nodes[a]]);
-        c.cols.insert(c.cols.end(), cols.begin(), cols.end());
-      }
+      append_mesh_nodes(c.rows, nodes_, std::span(f.nodes).first(f.nn()));
+      for (int a = 0; a < f.nn(); ++a) append_mesh_nodes(c.cols, nodes_, ring[f.nodes[a]]);
       std::sort(c.cols.begin(), c.cols.end());
       c.cols.erase(std::unique(c.cols.begin(), c.cols.end()), c.cols.end());
       out.push_back(std::move(c));
@@ -412,9 +407,9 @@ std::vector<NodeCoupling> PenaltySurfaceContact::prepare(const SolidModel& model
     if (!paired_.insert(key_of(gp)).second) continue;
     const contact::Face& fs = (gp.pass == 0 ? *slave_ : *master_).faces[gp.slave_face];
     const contact::Face& fm = (gp.pass == 0 ? *master_ : *slave_).faces[gp.master_face];
-    std::vector<int> nodes = mesh_nodes(nodes_, std::span(fs.nodes).first(fs.nn()));
-    const std::vector<int> more = mesh_nodes(nodes_, std::span(fm.nodes).first(fm.nn()));
-    nodes.insert(nodes.end(), more.begin(), more.end());
+    std::vector<int> nodes;
+    append_mesh_nodes(nodes, nodes_, std::span(fs.nodes).first(fs.nn()));
+    append_mesh_nodes(nodes, nodes_, std::span(fm.nodes).first(fm.nn()));
     out.push_back({nodes, nodes});
   }
   return out;
