@@ -28,80 +28,20 @@ finished run directory (e.g. run-<hash>/ of a study that was stopped) serves the
 baseline and the named changes only. Units: mm, N, MPa, s.
 """
 import argparse
-import copy
 import csv
 import json
 import os
 import sys
 
-import yaml
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts"))  # the tools
-from scene_variant import SetError, apply_set  # noqa: E402
+from scene_variant import StudyError, load_study  # noqa: E402
 from work_precision import ROOT, reused_run_dir, run_scene, scene_key  # noqa: E402
-
-STUDY_KEYS = ("base", "common", "changes")
-CHANGE_KEYS = ("name", "set")
 
 
 def fail(msg):
     print(f"sensitivity: error: {msg}", file=sys.stderr)
     sys.exit(2)
-
-
-def load_study(path):
-    """The study's runs: (base scene path, [(name, changes, scene)], baseline first)."""
-    try:
-        study = yaml.safe_load(open(path))
-    except (OSError, yaml.YAMLError) as e:
-        fail(f"{path}: {e}")
-    if not isinstance(study, dict):
-        fail(f"{path}: expected a map with keys {', '.join(STUDY_KEYS)}, got {type(study).__name__}")
-    for key in study:
-        if key not in STUDY_KEYS:
-            fail(f"{path}: {key}: unknown key, expected {', '.join(STUDY_KEYS)}")
-    for key in ("base", "changes"):
-        if key not in study:
-            fail(f"{path}: {key}: missing")
-    if not isinstance(study["changes"], list) or not study["changes"]:
-        fail(f"{path}: changes: expected a non-empty list of {{name, set}}")
-    base_path = os.path.normpath(os.path.join(os.path.dirname(path), str(study["base"])))
-    try:
-        base = yaml.safe_load(open(base_path))
-    except (OSError, yaml.YAMLError) as e:
-        fail(f"{path}: base: {e}")
-    if not isinstance(base, dict):
-        fail(f"{path}: base: {base_path} is not a scene (a map)")
-    runs, names = [], {"baseline"}
-    try:
-        apply_set(base, study.get("common") or {}, f"{path}: common")
-        runs.append(("baseline", {}, base))
-        for i, c in enumerate(study["changes"]):
-            where = f"{path}: changes[{i}]"
-            if not isinstance(c, dict):
-                fail(f"{where}: expected a map with name and set, got {c!r}")
-            for key in c:
-                if key not in CHANGE_KEYS:
-                    fail(f"{where}: {key}: unknown key, expected name and set")
-            name = c.get("name")
-            if not isinstance(name, str) or not name.strip():
-                fail(f"{where}: name: expected a non-empty string, got {name!r}")
-            if name in names:
-                fail(
-                    f"{where}: name: "
-                    + (
-                        "'baseline' names the unchanged run, expected another name"
-                        if name == "baseline"
-                        else f"'{name}' is given twice"
-                    )
-                )
-            names.add(name)
-            if not isinstance(c.get("set"), dict) or not c["set"]:
-                fail(f"{where} ({name}): set: expected a map of dotted key paths to values, got {c.get('set')!r}")
-            runs.append((name, c["set"], apply_set(copy.deepcopy(base), c["set"], f"{where} ({name}): set")))
-    except SetError as e:
-        fail(str(e))
-    return base_path, runs
 
 
 def columns(rows):
@@ -138,7 +78,10 @@ def main():
     )
     ap.add_argument("--only", nargs="+", metavar="NAME", help="run the baseline and these changes only")
     a = ap.parse_args()
-    base_path, runs = load_study(a.study)
+    try:
+        base_path, runs, _ = load_study(a.study)
+    except StudyError as e:
+        fail(str(e))
     if a.only:
         for n in a.only:
             if n not in {r[0] for r in runs[1:]}:

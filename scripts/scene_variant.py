@@ -3,7 +3,8 @@ stability.py, work_precision.py, sensitivity.py): the variant is written next to
 runs, so that the base's relative paths (e.g. `centerlines/...`) resolve as they do for the base,
 and it is launched through scripts/launch.py like any scene (the launcher sets one BLAS thread per
 process). Scene names resolve the same way in all of them (resolve_scene); changes given as dotted
-key paths are applied the same way in all of them (apply_set)."""
+key paths are applied the same way in all of them (apply_set), and study files (a base scene, common
+changes, named changes) are read the same way by sensitivity.py and bench_ranks.py (load_study)."""
 import contextlib
 import copy
 import json
@@ -65,6 +66,75 @@ def apply_set(scene, changes, where):
         else:
             node[parts[-1]] = copy.deepcopy(value)
     return scene
+
+
+class StudyError(ValueError):
+    """A bad study file (bench/sensitivity.py, bench/bench_ranks.py); the message names the file and key."""
+
+
+STUDY_KEYS = ("base", "common", "changes")
+
+
+def _yaml_map(path, where, expected):
+    """The map in the YAML file `path`; StudyError starting with `where` if unreadable or not a map."""
+    try:
+        doc = yaml.safe_load(open(path))
+    except (OSError, yaml.YAMLError) as e:
+        raise StudyError(f"{where}: {e}") from None
+    if not isinstance(doc, dict):
+        raise StudyError(f"{where}: expected {expected}, got {type(doc).__name__}")
+    return doc
+
+
+def load_study(path, extra_keys=()):
+    """A study file: `base` (a scene, relative to the study), `common` ({dotted.key.path: value} for
+    every run), `changes` (a non-empty list of {name, set}: the baseline plus `set` each), and the
+    calling script's own `extra_keys`. Returns (base scene path, [(name, changes, scene)] with the
+    baseline first and named "baseline", the study map); StudyError on a bad file."""
+    keys = STUDY_KEYS + tuple(extra_keys)
+    study = _yaml_map(path, f"{path}", f"a map with keys {', '.join(keys)}")
+    for key in study:
+        if key not in keys:
+            raise StudyError(f"{path}: {key}: unknown key, expected {', '.join(keys)}")
+    for key in ("base", "changes"):
+        if key not in study:
+            raise StudyError(f"{path}: {key}: missing")
+    if not isinstance(study["changes"], list) or not study["changes"]:
+        raise StudyError(f"{path}: changes: expected a non-empty list of {{name, set}}")
+    base_path = os.path.normpath(os.path.join(os.path.dirname(path), str(study["base"])))
+    base = _yaml_map(base_path, f"{path}: base", f"a scene (a map) in {base_path}")
+    runs, names = [], {"baseline"}
+    try:
+        apply_set(base, study.get("common") or {}, f"{path}: common")
+        runs.append(("baseline", {}, base))
+        for i, c in enumerate(study["changes"]):
+            where = f"{path}: changes[{i}]"
+            if not isinstance(c, dict):
+                raise StudyError(f"{where}: expected a map with name and set, got {c!r}")
+            for key in c:
+                if key not in ("name", "set"):
+                    raise StudyError(f"{where}: {key}: unknown key, expected name and set")
+            name = c.get("name")
+            if not isinstance(name, str) or not name.strip():
+                raise StudyError(f"{where}: name: expected a non-empty string, got {name!r}")
+            if name in names:
+                raise StudyError(
+                    f"{where}: name: "
+                    + (
+                        "'baseline' names the unchanged run, expected another name"
+                        if name == "baseline"
+                        else f"'{name}' is given twice"
+                    )
+                )
+            names.add(name)
+            if not isinstance(c.get("set"), dict) or not c["set"]:
+                raise StudyError(
+                    f"{where} ({name}): set: expected a map of dotted key paths to values, got {c.get('set')!r}"
+                )
+            runs.append((name, c["set"], apply_set(copy.deepcopy(base), c["set"], f"{where} ({name}): set")))
+    except SetError as e:
+        raise StudyError(str(e)) from None
+    return base_path, runs, study
 
 
 def resolve_scene(name):
