@@ -114,14 +114,22 @@ def row_of(name, ranks, run_dir, rc, wall):
     }
     if rc != 0:
         return row
-    s = summary_of(run_dir)
-    t = s["timing"]
+    try:
+        s = summary_of(run_dir)
+        row.update(measures_of(s["timing"]), results=results_of(s))
+    except (OSError, ValueError, KeyError, IndexError) as e:  # a solid without these figures (an old build)
+        row["status"] = f"error: solid/summary.json: {type(e).__name__}: {e}"
+    return row
+
+
+def measures_of(t):
+    """The row's figures from solid/summary.json's `timing`."""
     peak = t["peak_memory_mib_per_rank"]
     setup = t.get("setup_memory_mib_per_rank") or []
     msgs = t.get("petsc_messages_per_rank") or []
     vol = t.get("petsc_message_mib_per_rank") or []
     newton = t["newton_iterations"]
-    row.update(
+    return dict(
         dofs=t["dofs"],
         peak_mib_max=max(peak),
         peak_mib_min=min(peak),
@@ -137,9 +145,7 @@ def row_of(name, ranks, run_dir, rc, wall):
         linear_iterations=t["linear_iterations"],
         linear_s=t["linear_seconds"],
         solve_s=t["solve_seconds"],
-        results=results_of(s),
     )
-    return row
 
 
 def against_one_rank(rows):
@@ -228,12 +234,14 @@ def main():
         base = complete_patient(base, base_path, out_dir)
     if "stent" in base:
         base = alone_scene(base)
-    rows = []
+    scenes = []  # every change's scene before the first run, so a bad change stops nothing half done
     for name, changes, _ in runs:
         try:
-            scene = apply_set(copy.deepcopy(base), changes, f"{a.study}: changes ({name}): set")
+            scenes.append((name, apply_set(copy.deepcopy(base), changes, f"{a.study}: changes ({name}): set")))
         except SetError as e:
             fail(str(e))
+    rows = []
+    for name, scene in scenes:
         for n in ranks:
             run_dir = os.path.join(out_dir, f"run-{name}-{n}")
             shutil.rmtree(run_dir, ignore_errors=True)
