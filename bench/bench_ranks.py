@@ -13,9 +13,10 @@ A study file (YAML, e.g. configs/studies/patient_ranks_025.yaml) as for bench/se
   ranks    optional list of solid rank counts (default 1, 2, 4, 8; --ranks overrides)
 The baseline (the base with `common`) runs too. A scene with a stent runs as its solid alone (no
 stent, no coupling, no stent contact; bench_scenes.py's `alone` variant): the figures are the solid's.
-A patient scene (`patient:`) is completed once (scripts/patient: the artery meshed with gmsh, the
-devices placed) into OUT_DIR/geometry, before the stent is dropped; every run uses that mesh. The
-changes are applied to the completed scene, so `patient.*` keys belong in `common`.
+A patient scene (`patient:`) is completed once, as the launcher completes it (scripts/patient: the
+artery meshed with gmsh, the devices placed), into OUT_DIR/geometry and OUT_DIR/scene.yaml, before
+the stent is dropped; every run uses that mesh. The changes are applied to the completed scene, so
+`patient.*` keys belong in `common`.
 
 Per run, from the solid's solid/summary.json (`timing`): each rank's peak resident set and the same
 before the first solve (MiB, getrusage), PETSc's messages and their volume over all ranks (as
@@ -38,10 +39,14 @@ import os
 import shutil
 import sys
 import time
+from pathlib import Path
+
+import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "scripts"))  # the tools
 from bench_scenes import alone_scene, launch  # noqa: E402
+from launch import install_prepared, prepare_patient  # noqa: E402
 from scene_variant import SetError, StudyError, apply_set, load_study, variant_scene  # noqa: E402
 
 ROOT = os.path.dirname(HERE)
@@ -70,18 +75,11 @@ def rank_counts(value, where):
 
 
 def complete_patient(scene, base_path, out_dir):
-    """The patient pipeline's completed scene, its geometry in out_dir/geometry (meshed once)."""
-    from patient.errors import PatientInputError
-    from patient.prepare import prepare_scene
-
-    geometry = os.path.join(out_dir, "geometry")
-    shutil.rmtree(geometry, ignore_errors=True)
-    os.makedirs(geometry)
-    try:
-        done, _ = prepare_scene(scene, base_path, geometry, log=lambda m: print(f"[bench_ranks] {m}", file=sys.stderr))
-    except PatientInputError as e:
-        fail(str(e))
-    return done
+    """The patient pipeline's completed scene, meshed once, as the launcher completes it: its geometry
+    in out_dir/geometry, the completed scene in out_dir/scene.yaml (bad patient input: exit 2)."""
+    path = install_prepared(prepare_patient(scene, Path(base_path)), Path(out_dir))
+    with open(path) as f:
+        return yaml.safe_load(f)
 
 
 def summary_of(run_dir):

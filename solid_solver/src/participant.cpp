@@ -368,20 +368,18 @@ void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_
   const std::size_t owned = endothelium_area_.size();
   contact_pressure.assign(owned, 0.0);
   std::vector<Vec3d> total(owned, Vec3d::Zero());
-  std::vector<double> sums, summed(contact_reports_.size());
-  for (const auto& entry : contact_reports_) {
-    const std::vector<Vec3d> f = model_->contact_forces(*entry.second);
-    double sum = 0.0;
+  std::vector<double> force(contact_reports_.size(), 0.0);  // this rank's share, then the sum
+  for (size_t k = 0; k < contact_reports_.size(); ++k) {
+    const std::vector<Vec3d> f = model_->contact_forces(*contact_reports_[k].second);
     for (size_t i = 0; i < owned; ++i)
       if (endothelium_area_[i] > 0.0) {
-        sum += f[i].norm();
+        force[k] += f[i].norm();
         total[i] += f[i];
       }
-    sums.push_back(sum);
   }
-  MPI_Allreduce(sums.data(), summed.data(), int(sums.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, force.data(), int(force.size()), MPI_DOUBLE, MPI_SUM, comm_);
   for (size_t k = 0; k < contact_reports_.size(); ++k)
-    s.artery_contact_force.emplace_back(contact_reports_[k].first, summed[k]);
+    s.artery_contact_force.emplace_back(contact_reports_[k].first, force[k]);
   for (size_t i = 0; i < owned; ++i)
     if (endothelium_area_[i] > 0.0) contact_pressure[i] = total[i].norm() / endothelium_area_[i];
   if (stent_contact_) {
