@@ -22,8 +22,9 @@ double weighted_quantile(std::vector<double> values, std::vector<double> weights
   return values[order.back()];
 }
 
-LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<double>& station, int max_stations) {
-  if (nodes.empty()) return;
+LumenProfile::LumenProfile(const std::vector<double>& station, int max_stations) {
+  nodes_ = station.size();
+  if (station.empty()) return;
   const auto [lo, hi] = std::minmax_element(station.begin(), station.end());
   const double smin = *lo, smax = *hi, tol = 1e-6 * std::max(1.0, smax - smin);
   std::vector<double> distinct(station);
@@ -35,17 +36,17 @@ LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<doub
   // of its nodes from their centroid, which is biased low when a few nodes cover only part of the
   // circumference. Bins hold kMinNodes nodes on average, and sparse ones are dropped below.
   constexpr int kMinNodes = 24;
-  const int n = rings ? int(distinct.size()) : std::max(1, std::min(max_stations, int(nodes.size()) / kMinNodes));
+  const int n = rings ? int(distinct.size()) : std::max(1, std::min(max_stations, int(station.size()) / kMinNodes));
   groups_.assign(n, {});
   std::vector<double> sum(n, 0.0);
-  for (size_t i = 0; i < nodes.size(); ++i) {
+  for (size_t i = 0; i < station.size(); ++i) {
     int k;
     if (rings) {
       k = int(std::lower_bound(distinct.begin(), distinct.end(), station[i] - tol) - distinct.begin());
     } else {
       k = std::min(n - 1, int((station[i] - smin) / (smax - smin) * n));
     }
-    groups_[k].push_back(nodes[i]);
+    groups_[k].push_back(int(i));
     sum[k] += station[i];
   }
   // an empty bin, or (unstructured) one with too few nodes to go around the lumen, is no station
@@ -57,6 +58,7 @@ LumenProfile::LumenProfile(const std::vector<int>& nodes, const std::vector<doub
 }
 
 std::vector<double> LumenProfile::diameters(const std::vector<Vec3d>& x, std::vector<Vec3d>* centroids) const {
+  if (x.size() != nodes_) throw std::invalid_argument("LumenProfile::diameters: a position per lumen node expected");
   const size_t m = groups_.size();
   std::vector<Vec3d> c(m, Vec3d::Zero());
   for (size_t k = 0; k < m; ++k) {

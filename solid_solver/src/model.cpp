@@ -521,13 +521,15 @@ void SolidModel::restore_state(const std::vector<double>& u) {
   u_ = u;
 }
 
-Vec3d SolidModel::displacement(int node) const {
+Vec3d SolidModel::held_entry_(const std::vector<double>& v, int node) const {
   if (slot_[node] < 0)
     throw std::out_of_range("solid model: rank " + std::to_string(rank_) + " does not hold node " +
                             std::to_string(node));
   const int p = ldof_(node, 0);
-  return Vec3d(u_[p], u_[p + 1], u_[p + 2]);
+  return Vec3d(v[p], v[p + 1], v[p + 2]);
 }
+
+Vec3d SolidModel::displacement(int node) const { return held_entry_(u_, node); }
 
 void SolidModel::set_displacement(const std::vector<Vec3d>& u) {
   for (size_t n = 0; n < mesh_.X.size(); ++n)
@@ -535,32 +537,18 @@ void SolidModel::set_displacement(const std::vector<Vec3d>& u) {
       for (int k = 0; k < 3; ++k) u_[ldof_(int(n), k)] = u[n](k);
 }
 
-std::vector<Vec3d> SolidModel::gather_nodes_(const std::vector<double>& v, bool all) const {
-  // the owned nodes' entries (the first 3 (node_end_ - node_begin_) of a held state) in new numbering
+std::vector<Vec3d> SolidModel::gather_displacement() const {
+  // the owned nodes' entries (the first 3 (node_end_ - node_begin_) of u_) in new numbering
   const int mine = 3 * (node_end_ - node_begin_);
   std::vector<int> counts(size_), offsets(size_ + 1, 0);
   MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   for (int r = 0; r < size_; ++r) offsets[r + 1] = offsets[r] + counts[r];
-  std::vector<double> whole(all || rank_ == 0 ? offsets[size_] : 0);
-  if (all)
-    MPI_Allgatherv(v.data(), mine, MPI_DOUBLE, whole.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm_);
-  else
-    MPI_Gatherv(v.data(), mine, MPI_DOUBLE, whole.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0, comm_);
-  std::vector<Vec3d> out(whole.empty() ? 0 : mesh_.X.size());
+  std::vector<double> whole(offsets[size_]);
+  MPI_Allgatherv(u_.data(), mine, MPI_DOUBLE, whole.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm_);
+  std::vector<Vec3d> out(mesh_.X.size());
   for (size_t n = 0; n < out.size(); ++n)
     for (int k = 0; k < 3; ++k) out[n](k) = whole[3 * size_t(perm_[n]) + k];
   return out;
-}
-
-std::vector<Vec3d> SolidModel::gather_displacement() const { return gather_nodes_(u_, true); }
-
-bool SolidModel::gather_committed(std::vector<Vec3d>& u, std::vector<Vec3d>& before, double& before_time) const {
-  u = gather_nodes_(u_committed_, false);
-  before.clear();
-  if (u_before_.size() != u_committed_.size()) return false;  // the same on every rank
-  before = gather_nodes_(u_before_, false);
-  before_time = before_time_;
-  return true;
 }
 
 SolidModel::ViscousState SolidModel::viscous_state(size_t i) {
@@ -569,21 +557,28 @@ SolidModel::ViscousState SolidModel::viscous_state(size_t i) {
   return {int(volume_rule(el.type).size()), visc_Q_.data() + visc_offset_[i], visc_S_.data() + visc_offset_[i]};
 }
 
-void SolidModel::start_from(double t, const std::vector<Vec3d>& u, const std::vector<Vec3d>& u_before,
-                            double before_time) {
-  set_displacement(u);
+void SolidModel::start_from_held(double t, std::vector<double> u, std::vector<double> u_before, double before_time) {
+  if (u.size() != u_.size() || (!u_before.empty() && u_before.size() != u_.size()))
+    throw std::logic_error("start_from_held: not a state of the held nodes");
+  u_ = std::move(u);
   time_ = committed_time_ = t;
   apply_dirichlet_values_();
   u_committed_ = u_;
-  u_before_.clear();
-  if (!u_before.empty()) {
-    u_before_.resize(u_.size());
-    for (size_t n = 0; n < mesh_.X.size(); ++n)
-      if (holds(int(n)))
-        for (int k = 0; k < 3; ++k) u_before_[ldof_(int(n), k)] = u_before[n](k);
-    before_time_ = before_time;
-  }
+  u_before_ = std::move(u_before);
+  if (!u_before_.empty()) before_time_ = before_time;
   pc_current_ = false;
+}
+
+void SolidModel::start_from(double t, const std::vector<Vec3d>& u, const std::vector<Vec3d>& u_before,
+                            double before_time) {
+  std::vector<double> held(u_.size()), held_before(u_before.empty() ? 0 : u_.size());
+  for (size_t n = 0; n < mesh_.X.size(); ++n)
+    if (holds(int(n)))
+      for (int k = 0; k < 3; ++k) {
+        held[ldof_(int(n), k)] = u[n](k);
+        if (!u_before.empty()) held_before[ldof_(int(n), k)] = u_before[n](k);
+      }
+  start_from_held(t, std::move(held), std::move(held_before), before_time);
 }
 
 void SolidModel::gather_(Vec v, std::vector<double>& held) const {

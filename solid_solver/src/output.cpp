@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "angio/solid/file_blocks.hpp"
+
 namespace angio::solid {
 
 void make_directories(const std::string& dir) {
@@ -16,41 +18,6 @@ void make_directories(const std::string& dir) {
 }
 
 namespace {
-void h5check(herr_t e, const char* what) {
-  if (e < 0) throw std::runtime_error(std::string("HDF5 error: ") + what);
-}
-hid_t h5check_id(hid_t id, const char* what) {
-  if (id < 0) throw std::runtime_error(std::string("HDF5 error: ") + what);
-  return id;
-}
-
-// Collective write of rows [offset, offset+local_rows) of a [total_rows, cols] dataset.
-template <class T>
-void write_rows(hid_t file, const std::string& path, hid_t type, long total_rows, int cols, long offset,
-                long local_rows, const T* data) {
-  hsize_t dims[2] = {hsize_t(total_rows), hsize_t(cols)};
-  const int rank = cols > 1 ? 2 : 1;
-  hid_t space = h5check_id(H5Screate_simple(rank, dims, nullptr), "create space");
-  hid_t lcpl = H5Pcreate(H5P_LINK_CREATE);
-  H5Pset_create_intermediate_group(lcpl, 1);
-  hid_t ds = h5check_id(H5Dcreate2(file, path.c_str(), type, space, lcpl, H5P_DEFAULT, H5P_DEFAULT), path.c_str());
-  H5Pclose(lcpl);
-  hsize_t start[2] = {hsize_t(offset), 0}, count[2] = {hsize_t(local_rows), hsize_t(cols)};
-  if (local_rows > 0)
-    h5check(H5Sselect_hyperslab(space, H5S_SELECT_SET, start, nullptr, count, nullptr), "hyperslab");
-  else
-    H5Sselect_none(space);
-  hid_t mem = H5Screate_simple(rank, count, nullptr);
-  if (local_rows == 0) H5Sselect_none(mem);
-  hid_t xfer = H5Pcreate(H5P_DATASET_XFER);
-  H5Pset_dxpl_mpio(xfer, H5FD_MPIO_COLLECTIVE);
-  h5check(H5Dwrite(ds, type, mem, space, xfer, data), path.c_str());
-  H5Pclose(xfer);
-  H5Sclose(mem);
-  H5Sclose(space);
-  H5Dclose(ds);
-}
-
 // Static per-element vectors written once under /mesh/<type>/ when the mesh has fiber frames
 // (Mesh::frames, one per element): the local material frame (e_c, e_a, e_r) and the directions a0
 // of the element's fiber families resolved from it (materials.hpp, resolve_fibers), so that fiber
@@ -116,8 +83,8 @@ FieldWriter::FieldWriter(const SolidModel& model, const std::string& dir) : mode
     orig[i - n0] = o;
     for (int k = 0; k < 3; ++k) xyz[3 * (i - n0) + k] = mesh.X[o](k);
   }
-  write_rows(file_, "/mesh/coordinates", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, xyz.data());
-  write_rows(file_, "/mesh/original_node_id", H5T_NATIVE_INT, N, 1, n0, n1 - n0, orig.data());
+  write_block_rows(model_.comm(), file_, "/mesh/coordinates", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, xyz.data());
+  write_block_rows(model_.comm(), file_, "/mesh/original_node_id", H5T_NATIVE_INT, N, 1, n0, n1 - n0, orig.data());
   cell_vectors_ = cell_vector_names(model);
   // element types present anywhere
   for (ElemType t : {ElemType::Hex8, ElemType::Tet4, ElemType::Tet10}) {
@@ -144,9 +111,12 @@ FieldWriter::FieldWriter(const SolidModel& model, const std::string& dir) : mode
       oid[i] = e;
     }
     const std::string base = std::string("/mesh/") + name(t);
-    write_rows(file_, base + "/connectivity", H5T_NATIVE_INT, ti.total, nn, ti.offset, nloc, conn.data());
-    write_rows(file_, base + "/block_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc, block.data());
-    write_rows(file_, base + "/original_element_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc, oid.data());
+    write_block_rows(model_.comm(), file_, base + "/connectivity", H5T_NATIVE_INT, ti.total, nn, ti.offset, nloc,
+                     conn.data());
+    write_block_rows(model_.comm(), file_, base + "/block_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc,
+                     block.data());
+    write_block_rows(model_.comm(), file_, base + "/original_element_id", H5T_NATIVE_INT, ti.total, 1, ti.offset, nloc,
+                     oid.data());
     write_cell_vectors_(ti, base);
     types_.push_back(std::move(ti));
   }
@@ -162,7 +132,8 @@ void FieldWriter::write_cell_vectors_(const TypeInfo& ti, const std::string& bas
       for (int k = 0; k < 3; ++k) data[f][3 * i + k] = v[f](k);
   }
   for (size_t f = 0; f < cell_vectors_.size(); ++f)
-    write_rows(file_, base + "/" + cell_vectors_[f], H5T_NATIVE_DOUBLE, ti.total, 3, ti.offset, nloc, data[f].data());
+    write_block_rows(model_.comm(), file_, base + "/" + cell_vectors_[f], H5T_NATIVE_DOUBLE, ti.total, 3, ti.offset,
+                     nloc, data[f].data());
 }
 
 FieldWriter::~FieldWriter() {
@@ -202,13 +173,13 @@ void FieldWriter::write_step(int step, double time, const std::vector<double>& p
     const Vec3d d = model_.displacement(model_.old_index(int(i)));
     for (int k = 0; k < 3; ++k) u[3 * (i - n0) + k] = d(k);
   }
-  write_rows(file_, g + "/displacement", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, u.data());
+  write_block_rows(model_.comm(), file_, g + "/displacement", H5T_NATIVE_DOUBLE, N, 3, n0, n1 - n0, u.data());
   StepInfo info{step, time, {}};
   for (const auto& [field, values] : nodal) {
     if (long(values->size()) != n1 - n0)
       throw std::invalid_argument("write_step: nodal field " + field + " has " + std::to_string(values->size()) +
                                   " values for " + std::to_string(n1 - n0) + " owned nodes");
-    write_rows(file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, values->data());
+    write_block_rows(model_.comm(), file_, g + "/" + field, H5T_NATIVE_DOUBLE, N, 1, n0, n1 - n0, values->data());
     info.nodal.push_back(field);
   }
   for (const auto& ti : types_) {
@@ -219,8 +190,10 @@ void FieldWriter::write_step(int step, double time, const std::vector<double>& p
       for (int k = 0; k < 3; ++k) d[3 * i + k] = dir[ti.local[i]](k);
     }
     const std::string base = g + "/" + name(ti.type);
-    write_rows(file_, base + "/stress_p1", H5T_NATIVE_DOUBLE, ti.total, 1, ti.offset, nloc, s.data());
-    write_rows(file_, base + "/stress_p1_dir", H5T_NATIVE_DOUBLE, ti.total, 3, ti.offset, nloc, d.data());
+    write_block_rows(model_.comm(), file_, base + "/stress_p1", H5T_NATIVE_DOUBLE, ti.total, 1, ti.offset, nloc,
+                     s.data());
+    write_block_rows(model_.comm(), file_, base + "/stress_p1_dir", H5T_NATIVE_DOUBLE, ti.total, 3, ti.offset, nloc,
+                     d.data());
   }
   {  // pseudo-time as an attribute of the step group (collective, same value on all ranks)
     hid_t grp = H5Gopen2(file_, g.c_str(), H5P_DEFAULT);

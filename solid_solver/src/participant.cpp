@@ -70,7 +70,7 @@ SolidRunner::SolidRunner(MPI_Comm comm, SolidScene scene, const std::string& run
     nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
     std::vector<double> st(nodes.size());
     for (size_t i = 0; i < nodes.size(); ++i) st[i] = scene_.lumen->station(mesh.X[nodes[i]]);
-    lumen_ = LumenProfile(nodes, st, scene_.lumen_max_stations);
+    lumen_ = LumenProfile(st, scene_.lumen_max_stations);
     const std::vector<double> area = nodal_areas(mesh, *endo);  // by mesh node
     const int n0 = model_->owned_node_begin();
     endothelium_area_.resize(model_->owned_node_end() - n0);
@@ -351,8 +351,8 @@ void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_
   MPI_Allreduce(umax.data(), all.data(), int(parts.size()), MPI_DOUBLE, MPI_MAX, comm_);
   for (std::size_t k = 0; k < parts.size(); ++k) s.max_displacement.emplace_back(parts[k], all[k]);
   if (lumen_.empty()) return;
-  std::vector<Vec3d> x(mesh.X.size(), Vec3d::Constant(std::numeric_limits<double>::quiet_NaN()));
-  for (int n : lumen_nodes_) x[n] = model_->position(n);  // held: the lumen's diameters read these
+  std::vector<Vec3d> x(lumen_nodes_.size());  // held on every rank: the lumen's diameters read these
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = model_->position(lumen_nodes_[i]);
   s.lumen_diameter = lumen_.diameters(x, &s.lumen_centroid);
   if (!stent_x_.empty()) {  // where the stent sits, in the station coordinate of the lumen profile
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -564,6 +564,7 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
                    {"solve_seconds", t.total_seconds},
                    {"stress_recovery_seconds", recovery_seconds_},
                    {"stress_summary_seconds", stress_summary_seconds_},
+                   {"state_file_seconds", state_file_seconds_},
                    {"peak_memory_mib_per_rank", peak_mib},
                    {"setup_memory_mib_per_rank", setup_mib},
                    {"petsc_messages_per_rank", messages},
@@ -572,6 +573,7 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
                    {"note",
                     "assembly_seconds includes contact_seconds; solve_seconds = assembly + linear + the rest; "
                     "contact_reply_seconds: the stent contact's replies and per-step gaps, after the solves; "
+                    "state_file_seconds: the state file's writes (every rank writes its block); "
                     "*_per_rank in rank order, so far in the run: the peak resident set (getrusage), the same before "
                     "the first solve (setup: libraries, the mesh, the model, the matrix's pattern, the contact's "
                     "structures), PETSc's messages and their volume as -log_view counts them (not MUMPS' own "
@@ -656,19 +658,21 @@ void SolidRunner::write_summary_json_(const std::vector<double>& per_rank, doubl
 void SolidRunner::write_state_() {
   if (!writer_ || !scene_.output.state || state_step_ == committed_) return;
   state_step_ = committed_;
-  try {  // only rank 0 writes (after a collective gather): a failure there must not stop the run
+  const double t0 = MPI_Wtime();
+  try {  // every rank writes its block; HDF5 fails on all of them alike, which must not stop the run
     write_state_file(*model_, dir_ + "/state.h5", committed_);
   } catch (const std::exception& e) {
     LOG_WARN("solid: state file not written at step " << committed_ << ": " << e.what()
                                                       << " (the previous one, if any, is kept)");
   }
+  state_file_seconds_ += MPI_Wtime() - t0;
 }
 
 void SolidRunner::finish() {
   if (finished_) return;
   finished_ = true;
-  write_summary_();  // the timing of the solves after the last commit
   write_state_();
+  write_summary_();  // the timing of the solves after the last commit and of that state file
   if (writer_) writer_->close();
 }
 

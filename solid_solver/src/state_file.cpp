@@ -5,18 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 
 #include "angio/common/h5_io.hpp"
-#include "angio/solid/gather.hpp"
+#include "angio/solid/file_blocks.hpp"
 
 namespace angio::solid {
 
 using h5::H5Id;
 using h5::Reader;
 using h5::write_attribute;
-using h5::write_dataset;
-using h5::write_rows;
 
 namespace {
 constexpr int kFormat = 1;
@@ -52,70 +49,124 @@ std::vector<int> part_nodes(const Mesh& mesh, const std::string& part) {
 }
 
 void write_state_file(SolidModel& model, const std::string& path, int step) {
+  // Written by all ranks together (MPI-IO), each rank's rows sent to the rank that writes their
+  // block of the file (file_blocks.hpp): no rank gathers the whole mesh's state.
   const Mesh& mesh = model.mesh();
-  // every rank's viscous history as (element, points, Q..., Sv...) rows, gathered on rank 0
-  std::vector<double> mine;
-  const auto& le = model.local_elements();
-  for (size_t i = 0; i < le.size(); ++i) {
-    const auto v = model.viscous_state(i);
-    if (v.points == 0) continue;
-    mine.push_back(le[i]);
-    mine.push_back(v.points);
-    for (int g = 0; g < v.points; ++g) mine.insert(mine.end(), v.Q[g].data(), v.Q[g].data() + 6);
-    for (int g = 0; g < v.points; ++g) mine.insert(mine.end(), v.Sv[g].data(), v.Sv[g].data() + 6);
-  }
-  const std::vector<double> all = gather_on_root(model.comm(), mine);
-  std::vector<Vec3d> committed, before;
-  double before_time = 0.0;
-  const bool has_before = model.gather_committed(committed, before, before_time);  // on rank 0
-  if (model.rank() != 0) return;
-  std::map<int, size_t> at;  // element -> offset of its row in `all`
-  for (size_t k = 0; k < all.size(); k += 2 + 12 * size_t(all[k + 1])) at[int(all[k])] = k;
-
+  MPI_Comm comm = model.comm();
   const std::string tmp = path + ".tmp";
+  const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
   {
-    H5Id file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    H5Id file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), H5Fclose);
+    H5Pclose(fapl);
     if (file.id < 0) throw StateFileError("cannot create " + tmp);
     const int format = kFormat;
     const double time = model.committed_time();
     write_attribute(file, "format", H5T_NATIVE_INT, &format);
     write_attribute(file, "time", H5T_NATIVE_DOUBLE, &time);
     write_attribute(file, "step", H5T_NATIVE_INT, &step);
-    H5Id parts(H5Gcreate2(file, "parts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    const bool before = model.has_commit_before();
+    const double before_time = model.before_time();
+    const auto& le = model.local_elements();
     for (const auto& name : part_names(mesh)) {
-      H5Id g(H5Gcreate2(parts, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      const std::string g = "/parts/" + name + "/";
+      // the part's nodes this rank owns: reference coordinates, displacement and the one before
       const auto nodes = part_nodes(mesh, name);
-      std::vector<Vec3d> X(nodes.size()), u(nodes.size()), ub(nodes.size());
-      for (size_t i = 0; i < nodes.size(); ++i) {
-        X[i] = mesh.X[nodes[i]];
-        u[i] = committed[nodes[i]];
-        if (has_before) ub[i] = before[nodes[i]];
+      std::vector<long> position, start{0};
+      std::vector<double> rows;
+      for (int i = model.owned_node_begin(); i < model.owned_node_end(); ++i) {
+        const int n = model.old_index(i);
+        const auto it = std::lower_bound(nodes.begin(), nodes.end(), n);
+        if (it == nodes.end() || *it != n) continue;
+        position.push_back(long(it - nodes.begin()));
+        const Vec3d u = model.committed_displacement(n);
+        rows.insert(rows.end(), mesh.X[n].data(), mesh.X[n].data() + 3);
+        rows.insert(rows.end(), u.data(), u.data() + 3);
+        if (before) {
+          const Vec3d ub = model.displacement_before(n);
+          rows.insert(rows.end(), ub.data(), ub.data() + 3);
+        }
+        start.push_back(long(rows.size()));
       }
-      write_rows(g, "coordinates", X);
-      write_rows(g, "displacement", u);
-      if (has_before) {
-        write_rows(g, "displacement_before", ub);
-        H5Id ds(H5Dopen2(g, "displacement_before", H5P_DEFAULT), H5Dclose);
+      const int width = before ? 9 : 6;
+      FileBlock b = to_file_block(comm, long(nodes.size()), position, start, rows);
+      rows = {};
+      std::vector<double> column(3 * std::size_t(b.size()));
+      auto write_column = [&](int first, const char* dataset) {  // values first..first+2 of each row
+        for (long i = 0; i < b.size(); ++i)
+          for (int k = 0; k < 3; ++k) column[3 * i + k] = b.values[std::size_t(width * i + first + k)];
+        write_block_rows(comm, file, g + dataset, H5T_NATIVE_DOUBLE, long(nodes.size()), 3, b.begin, b.size(),
+                         column.data());
+      };
+      write_column(0, "coordinates");
+      write_column(3, "displacement");
+      if (before) {
+        write_column(6, "displacement_before");
+        H5Id ds(H5Dopen2(file, (g + "displacement_before").c_str(), H5P_DEFAULT), H5Dclose);
         write_attribute(ds, "before_time", H5T_NATIVE_DOUBLE, &before_time);
       }
-      std::vector<int> points;
-      std::vector<double> Q, Sv;
-      for (int e : part_elements(mesh, name)) {
-        const auto it = at.find(e);
-        const int np = it == at.end() ? 0 : int(all[it->second + 1]);
-        points.push_back(np);
-        if (!np) continue;
-        const double* q = all.data() + it->second + 2;
-        Q.insert(Q.end(), q, q + 6 * np);
-        Sv.insert(Sv.end(), q + 6 * np, q + 12 * np);
+      // the part's elements this rank assembles: their Gauss points' viscous history (Q, then Sv)
+      const auto elems = part_elements(mesh, name);
+      position.clear();
+      start.assign(1, 0);
+      for (std::size_t i = 0; i < le.size(); ++i) {
+        const auto it = std::lower_bound(elems.begin(), elems.end(), le[i]);
+        if (it == elems.end() || *it != le[i]) continue;
+        position.push_back(long(it - elems.begin()));
+        const auto v = model.viscous_state(i);
+        for (int p = 0; p < v.points; ++p) rows.insert(rows.end(), v.Q[p].data(), v.Q[p].data() + 6);
+        for (int p = 0; p < v.points; ++p) rows.insert(rows.end(), v.Sv[p].data(), v.Sv[p].data() + 6);
+        start.push_back(long(rows.size()));
       }
-      write_dataset(g, "viscous_points", H5T_NATIVE_INT, points.size(), 1, points.data());
-      write_dataset(g, "viscous_Q", H5T_NATIVE_DOUBLE, Q.size() / 6, 6, Q.data());
-      write_dataset(g, "viscous_Sv", H5T_NATIVE_DOUBLE, Sv.size() / 6, 6, Sv.data());
+      b = to_file_block(comm, long(elems.size()), position, start, rows);
+      rows = {};
+      std::vector<int> points(std::size_t(b.size()));
+      long mine = 0, first = 0, all = 0;  // this block's Gauss points, the row of its first, all of them
+      for (long i = 0; i < b.size(); ++i) mine += points[i] = int((b.start[i + 1] - b.start[i]) / 12);
+      MPI_Exscan(&mine, &first, 1, MPI_LONG, MPI_SUM, comm);
+      if (model.rank() == 0) first = 0;
+      MPI_Allreduce(&mine, &all, 1, MPI_LONG, MPI_SUM, comm);
+      write_block_rows(comm, file, g + "viscous_points", H5T_NATIVE_INT, long(elems.size()), 1, b.begin, b.size(),
+                       points.data());
+      std::vector<double> Q, Sv;
+      Q.reserve(6 * std::size_t(mine));
+      Sv.reserve(6 * std::size_t(mine));
+      for (long i = 0; i < b.size(); ++i) {
+        const auto q = b.values.begin() + b.start[i];
+        Q.insert(Q.end(), q, q + 6 * points[i]);
+        Sv.insert(Sv.end(), q + 6 * points[i], q + 12 * points[i]);
+      }
+      write_block_rows(comm, file, g + "viscous_Q", H5T_NATIVE_DOUBLE, all, 6, first, mine, Q.data());
+      write_block_rows(comm, file, g + "viscous_Sv", H5T_NATIVE_DOUBLE, all, 6, first, mine, Sv.data());
     }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw StateFileError("cannot rename " + tmp + " to " + path);
+  // the complete file replaces the last one only once every rank has closed it
+  MPI_Barrier(comm);
+  int renamed = 1;
+  if (model.rank() == 0) renamed = std::rename(tmp.c_str(), path.c_str()) == 0;
+  MPI_Bcast(&renamed, 1, MPI_INT, 0, comm);
+  if (!renamed) throw StateFileError("cannot rename " + tmp + " to " + path);
 }
+
+namespace {
+constexpr hsize_t kChunkRows = 1 << 16;  // rows read at a time: a rank holds a chunk, never a part's table
+
+// f(first row, values) for consecutive chunks of the first `rows` rows of a [rows, cols] table.
+template <class T, class F>
+void for_each_chunk(const Reader& r, hid_t g, const char* table, hid_t type, int cols, long rows, F&& f) {
+  for (hsize_t first = 0; first < hsize_t(rows); first += kChunkRows) {
+    const hsize_t n = std::min(kChunkRows, hsize_t(rows) - first);
+    f(long(first), r.block<T>(g, table, type, cols, first, n));
+  }
+}
+
+// A part's group of an open state file.
+hid_t open_part(const Reader& r, hid_t file, const std::string& part) {
+  const hid_t g = H5Gopen2(file, ("parts/" + part).c_str(), H5P_DEFAULT);
+  if (g < 0) r.fail("cannot open /parts/" + part);
+  return g;
+}
+}  // namespace
 
 StateFile read_state_file(const std::string& path) {
   Reader r{path};
@@ -139,28 +190,35 @@ StateFile read_state_file(const std::string& path) {
       r.fail("cannot list /parts");
     PartState p;
     p.name = name;
-    H5Id g(H5Gopen2(parts, name, H5P_DEFAULT), H5Gclose);
+    H5Id g(open_part(r, file, p.name), H5Gclose);
     const std::string at = "/parts/" + p.name + "/";
-    p.X = r.rows<3>(g, "coordinates");
-    p.u = r.rows<3>(g, "displacement");
-    if (p.u.size() != p.X.size()) r.fail(at + "displacement: not one row per node");
+    auto finite_rows = [&](const char* table, int cols) {  // its rows, every value checked finite
+      const long rows = long(r.table_rows(g, table, cols));
+      for_each_chunk<double>(r, g, table, H5T_NATIVE_DOUBLE, cols, rows, [&](long first, const std::vector<double>& v) {
+        for (std::size_t k = 0; k < v.size(); ++k)
+          if (!std::isfinite(v[k]))
+            r.fail("dataset " + std::string(table) + ": row " + std::to_string(first + long(k) / cols) +
+                   " is not finite");
+      });
+      return rows;
+    };
+    p.nodes = finite_rows("coordinates", 3);
+    if (finite_rows("displacement", 3) != p.nodes) r.fail(at + "displacement: not one row per node");
     if (r.exists(g, "displacement_before")) {
-      p.u_before = r.rows<3>(g, "displacement_before");
-      if (p.u_before.size() != p.X.size()) r.fail(at + "displacement_before: not one row per node");
+      if (finite_rows("displacement_before", 3) != p.nodes) r.fail(at + "displacement_before: not one row per node");
       H5Id ds(H5Dopen2(g, "displacement_before", H5P_DEFAULT), H5Dclose);
       s.before_time = r.attribute<double>(ds, "before_time", H5T_NATIVE_DOUBLE);
       s.has_before = true;
     }
-    hsize_t rows = 0;
-    p.viscous_points = r.dataset<int>(g, "viscous_points", H5T_NATIVE_INT, 1, rows);
-    p.Q = r.rows<6>(g, "viscous_Q");
-    p.Sv = r.rows<6>(g, "viscous_Sv");
-    long total = 0;
-    for (int np : p.viscous_points) {
-      if (np < 0) r.fail(at + "viscous_points: negative");
-      total += np;
-    }
-    if (size_t(total) != p.Q.size() || p.Q.size() != p.Sv.size()) r.fail(at + "viscous_Q/Sv: not one row per point");
+    p.elements = long(r.table_rows(g, "viscous_points", 1));
+    for_each_chunk<int>(r, g, "viscous_points", H5T_NATIVE_INT, 1, p.elements, [&](long, const std::vector<int>& v) {
+      for (int np : v) {
+        if (np < 0) r.fail(at + "viscous_points: negative");
+        p.points += np;
+      }
+    });
+    if (finite_rows("viscous_Q", 6) != p.points || finite_rows("viscous_Sv", 6) != p.points)
+      r.fail(at + "viscous_Q/Sv: not one row per point");
     s.parts.push_back(std::move(p));
   }
   return s;
@@ -168,61 +226,108 @@ StateFile read_state_file(const std::string& path) {
 
 void check_state(const StateFile& state, const Mesh& mesh, const std::vector<std::string>& parts,
                  const std::vector<LayerMaterial>& materials) {
+  const Reader r{state.path};
+  h5::QuietErrors quiet;
+  H5Id file(h5::open_for_reading(r), H5Fclose);
   for (const auto& name : parts) {
     const PartState* p = state.part(name);
     if (!p) throw StateFileError(state.path + ": has no part '" + name + "'");
     const auto nodes = part_nodes(mesh, name);
     if (nodes.empty()) throw StateFileError(state.path + ": part '" + name + "' is not in this scene's mesh");
-    if (nodes.size() != p->X.size())
-      throw StateFileError(state.path + ": part '" + name + "' has " + std::to_string(p->X.size()) +
+    if (long(nodes.size()) != p->nodes)
+      throw StateFileError(state.path + ": part '" + name + "' has " + std::to_string(p->nodes) +
                            " nodes, this scene's mesh " + std::to_string(nodes.size()) + " (a different mesh)");
-    for (size_t i = 0; i < nodes.size(); ++i)
-      if ((mesh.X[nodes[i]] - p->X[i]).norm() > kCoordinateTolerance)
-        throw StateFileError(state.path + ": part '" + name + "' node " + std::to_string(i) +
-                             " lies elsewhere in this scene's mesh (a different mesh)");
+    H5Id g(open_part(r, file, name), H5Gclose);
+    for_each_chunk<double>(
+        r, g, "coordinates", H5T_NATIVE_DOUBLE, 3, p->nodes, [&](long first, const std::vector<double>& X) {
+          for (std::size_t i = 0; 3 * i < X.size(); ++i)
+            if ((mesh.X[nodes[first + i]] - Vec3d(X[3 * i], X[3 * i + 1], X[3 * i + 2])).norm() > kCoordinateTolerance)
+              throw StateFileError(state.path + ": part '" + name + "' node " + std::to_string(first + long(i)) +
+                                   " lies elsewhere in this scene's mesh (a different mesh)");
+        });
     const auto elems = part_elements(mesh, name);
-    if (elems.size() != p->viscous_points.size())
-      throw StateFileError(state.path + ": part '" + name + "' has " + std::to_string(p->viscous_points.size()) +
+    if (long(elems.size()) != p->elements)
+      throw StateFileError(state.path + ": part '" + name + "' has " + std::to_string(p->elements) +
                            " elements, this scene's mesh " + std::to_string(elems.size()));
-    for (size_t k = 0; k < elems.size(); ++k)
-      if (viscous_points_of(mesh, materials, elems[k]) != p->viscous_points[k])
-        throw StateFileError(state.path + ": part '" + name + "' element " + std::to_string(k) + ": viscous history " +
-                             (p->viscous_points[k] ? "in the file, not in this scene's material"
-                                                   : "in this scene's material, not in the file"));
+    for_each_chunk<int>(r, g, "viscous_points", H5T_NATIVE_INT, 1, p->elements,
+                        [&](long first, const std::vector<int>& points) {
+                          for (std::size_t k = 0; k < points.size(); ++k)
+                            if (viscous_points_of(mesh, materials, elems[first + k]) != points[k])
+                              throw StateFileError(state.path + ": part '" + name + "' element " +
+                                                   std::to_string(first + long(k)) + ": viscous history " +
+                                                   (points[k] ? "in the file, not in this scene's material"
+                                                              : "in this scene's material, not in the file"));
+                        });
   }
 }
 
 void apply_state(SolidModel& model, const StateFile& state, const std::vector<std::string>& parts) {
   const Mesh& mesh = model.mesh();
-  std::vector<Vec3d> u(mesh.X.size(), Vec3d::Zero()), ub;
-  if (state.has_before) ub.assign(mesh.X.size(), Vec3d::Zero());
-  std::vector<long> offset(mesh.elements.size(), -1);  // first history row of each element in its part
-  std::vector<const PartState*> of(mesh.elements.size(), nullptr);
+  const Reader r{state.path};
+  h5::QuietErrors quiet;
+  H5Id file(h5::open_for_reading(r), H5Fclose);
+  // read again since the scene reader checked it: a run that still writes it may have replaced it
+  if (r.attribute<double>(file, "time", H5T_NATIVE_DOUBLE) != state.time ||
+      r.attribute<int>(file, "step", H5T_NATIVE_INT) != state.step)
+    r.fail("replaced since the scene was read (another time or step): continue from a state file no run writes");
+  // the held nodes' displacement and the commit before (held order; nodes of other parts: none)
+  std::vector<double> u(3 * std::size_t(model.num_held_nodes()), 0.0), ub(state.has_before ? u.size() : 0, 0.0);
+  // this rank's elements' viscous history (elements of other parts: none)
+  const auto& le = model.local_elements();
+  for (std::size_t i = 0; i < le.size(); ++i) {
+    const auto v = model.viscous_state(i);
+    std::fill(v.Q, v.Q + v.points, Vec6::Zero());
+    std::fill(v.Sv, v.Sv + v.points, Vec6::Zero());
+  }
   for (const auto& name : parts) {
     const PartState* p = state.part(name);
+    H5Id g(open_part(r, file, name), H5Gclose);
     const auto nodes = part_nodes(mesh, name);
-    for (size_t i = 0; i < nodes.size(); ++i) {
-      u[nodes[i]] = p->u[i];
-      if (state.has_before) ub[nodes[i]] = p->u_before.empty() ? p->u[i] : p->u_before[i];
-    }
+    auto take = [&](const char* table, std::vector<double>& into) {  // the held nodes' rows of a table
+      for_each_chunk<double>(r, g, table, H5T_NATIVE_DOUBLE, 3, p->nodes,
+                             [&](long first, const std::vector<double>& v) {
+                               for (std::size_t i = 0; 3 * i < v.size(); ++i)
+                                 if (const int h = model.held_index(nodes[first + i]); h >= 0)
+                                   std::copy_n(v.begin() + 3 * i, 3, into.begin() + 3 * h);
+                             });
+    };
+    take("displacement", u);
+    if (state.has_before) take(r.exists(g, "displacement_before") ? "displacement_before" : "displacement", ub);
+    // the Gauss points of this rank's elements of the part, by their row in viscous_Q and viscous_Sv
     const auto elems = part_elements(mesh, name);
+    std::vector<long> want;  // positions in elems of this rank's elements (ascending, as le is)
+    std::vector<std::size_t> local;
+    for (std::size_t i = 0; i < le.size(); ++i)
+      if (const auto it = std::lower_bound(elems.begin(), elems.end(), le[i]); it != elems.end() && *it == le[i]) {
+        want.push_back(long(it - elems.begin()));
+        local.push_back(i);
+      }
+    std::vector<std::pair<long, std::size_t>> rows;  // (row, local element) per Gauss point, ascending row
     long row = 0;
-    for (size_t k = 0; k < elems.size(); ++k) {
-      offset[elems[k]] = row;
-      of[elems[k]] = p;
-      row += p->viscous_points[k];
+    std::size_t next = 0;
+    for_each_chunk<int>(r, g, "viscous_points", H5T_NATIVE_INT, 1, p->elements,
+                        [&](long first, const std::vector<int>& points) {
+                          for (std::size_t k = 0; k < points.size(); row += points[k], ++k)
+                            if (next < want.size() && want[next] == first + long(k)) {
+                              for (int q = 0; q < points[k]; ++q) rows.emplace_back(row + q, local[next]);
+                              ++next;
+                            }
+                        });
+    for (const bool is_q : {true, false}) {
+      std::size_t at = 0, seen = 0;  // the next Gauss point to fill; its place in its element
+      for_each_chunk<double>(r, g, is_q ? "viscous_Q" : "viscous_Sv", H5T_NATIVE_DOUBLE, 6, p->points,
+                             [&](long first, const std::vector<double>& v) {
+                               const long end = first + long(v.size() / 6);
+                               for (; at < rows.size() && rows[at].first < end; ++at) {
+                                 const auto s = model.viscous_state(rows[at].second);
+                                 seen = at > 0 && rows[at - 1].second == rows[at].second ? seen + 1 : 0;
+                                 Vec6& dst = is_q ? s.Q[seen] : s.Sv[seen];
+                                 for (int c = 0; c < 6; ++c) dst(c) = v[std::size_t(6 * (rows[at].first - first) + c)];
+                               }
+                             });
     }
   }
-  model.start_from(state.time, u, ub, state.before_time);
-  const auto& le = model.local_elements();
-  for (size_t i = 0; i < le.size(); ++i) {
-    auto v = model.viscous_state(i);
-    for (int g = 0; g < v.points; ++g) {
-      const PartState* p = of[le[i]];
-      v.Q[g] = p ? p->Q[offset[le[i]] + g] : Vec6::Zero();
-      v.Sv[g] = p ? p->Sv[offset[le[i]] + g] : Vec6::Zero();
-    }
-  }
+  model.start_from_held(state.time, std::move(u), std::move(ub), state.before_time);
 }
 
 }  // namespace angio::solid

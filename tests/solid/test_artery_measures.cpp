@@ -56,9 +56,14 @@ TEST(ArteryMeasures, LumenProfileOfATube) {
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   std::vector<double> s;
   for (int n : nodes) s.push_back(m.X[n](2));
-  const LumenProfile lp(nodes, s, 100);
-  ASSERT_EQ(lp.stations().size(), 9u);  // the rings of the structured tube
-  std::vector<Vec3d> x = m.X;
+  const LumenProfile lp(s, 100);
+  ASSERT_EQ(lp.stations().size(), 9u);                   // the rings of the structured tube
+  auto positions = [&](const std::vector<Vec3d>& all) {  // of the endothelium nodes, in their order
+    std::vector<Vec3d> out;
+    for (int n : nodes) out.push_back(all[n]);
+    return out;
+  };
+  std::vector<Vec3d> x = positions(m.X);
   for (double d : lp.diameters(x)) EXPECT_NEAR(d, 1.6, 1e-12);
   // the centroids are the tube's axis points at the stations, and move with a rigid translation
   std::vector<Vec3d> c;
@@ -68,15 +73,17 @@ TEST(ArteryMeasures, LumenProfileOfATube) {
   for (auto& p : x) p += Vec3d(0.3, -0.2, 1.0);
   for (double d : lp.diameters(x, &c)) EXPECT_NEAR(d, 1.6, 1e-12);
   for (size_t k = 0; k < c.size(); ++k) EXPECT_LT((c[k] - Vec3d(0.3, -0.2, 1.0 + lp.stations()[k])).norm(), 1e-12);
-  x = m.X;
+  std::vector<Vec3d> scaled = m.X;
   for (int n : nodes)
-    if (std::abs(m.X[n](2)) < 1e-9) x[n].head<2>() *= 1.25;  // the middle station (z = 0)
-  const auto d = lp.diameters(x);
+    if (std::abs(m.X[n](2)) < 1e-9) scaled[n].head<2>() *= 1.25;  // the middle station (z = 0)
+  const auto d = lp.diameters(positions(scaled));
   for (size_t k = 0; k < d.size(); ++k)
     EXPECT_NEAR(d[k], std::abs(lp.stations()[k]) < 1e-9 ? 2.0 : 1.6, 1e-12) << "station " << lp.stations()[k];
   // fewer allowed stations than rings: equal bins
-  const LumenProfile coarse(nodes, s, 4);
+  const LumenProfile coarse(s, 4);
   EXPECT_EQ(coarse.stations().size(), 4u);
+  // positions of another node list (the whole mesh's) are refused, not read out of order
+  EXPECT_THROW(lp.diameters(m.X), std::invalid_argument);
 }
 
 // Consistency on an unstructured endothelium (tet10 patient arteries): 480 nodes evenly spread
@@ -85,7 +92,6 @@ TEST(ArteryMeasures, LumenProfileOfATube) {
 // midpoint; stations of >= 8 nodes measured in their cross-section give the diameter to 3 %.
 TEST(ArteryMeasures, LumenProfileOfAnUnstructuredSurface) {
   std::vector<Vec3d> x;
-  std::vector<int> nodes;
   std::vector<double> s;
   std::mt19937 gen(12345u);
   std::uniform_real_distribution<double> jitter(-0.4, 0.4);
@@ -93,12 +99,11 @@ TEST(ArteryMeasures, LumenProfileOfAnUnstructuredSurface) {
     const double offset = jitter(gen);
     for (int k = 0; k < 12; ++k) {
       const double th = 2.0 * std::numbers::pi * (k + offset + jitter(gen)) / 12.0, z = 0.25 * (j + jitter(gen));
-      nodes.push_back(int(x.size()));
       x.emplace_back(0.8 * std::cos(th), 0.8 * std::sin(th), z);
       s.push_back(z);
     }
   }
-  const LumenProfile lp(nodes, s, 100);
+  const LumenProfile lp(s, 100);
   EXPECT_EQ(lp.stations().size(), 20u);  // 480 nodes / 24 per station
   for (double d : lp.diameters(x)) EXPECT_NEAR(d, 1.6, 0.03 * 1.6);
 }

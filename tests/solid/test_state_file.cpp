@@ -11,9 +11,11 @@
 #include <fstream>
 #include <regex>
 
+#include "angio/common/h5_io.hpp"
 #include "angio/participant/standalone.hpp"
 #include "angio/solid/participant.hpp"
 #include "angio/solid/scene.hpp"
+#include "angio/solid/state_file.hpp"
 #include "mpi_test.hpp"
 
 using namespace angio::solid;
@@ -100,6 +102,35 @@ double max_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b) 
   return d;
 }
 
+// A table of a state file read whole: the tests' own reading of what the solver reads in chunks.
+template <int N>
+std::vector<Eigen::Matrix<double, N, 1>> table(const std::string& path, const std::string& dataset) {
+  const angio::h5::Reader r{path};
+  const angio::h5::H5Id f(angio::h5::open_for_reading(r), H5Fclose);
+  return r.rows<N>(f, dataset);
+}
+std::vector<int> viscous_points(const std::string& path, const std::string& part) {
+  const angio::h5::Reader r{path};
+  const angio::h5::H5Id f(angio::h5::open_for_reading(r), H5Fclose);
+  hsize_t rows = 0;
+  return r.dataset<int>(f, "parts/" + part + "/viscous_points", H5T_NATIVE_INT, 1, rows);
+}
+
+// A copy of a state file with the artery's viscous overstresses Q set to zero (a fresh viscous branch).
+std::string without_history(const std::string& state) {
+  const std::string copy = dir_of("no_history_state.h5");
+  if (world_rank() == 0) {
+    std::filesystem::copy_file(state, copy, std::filesystem::copy_options::overwrite_existing);
+    const angio::h5::H5Id f(H5Fopen(copy.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+    const angio::h5::H5Id ds(H5Dopen2(f, "parts/artery/viscous_Q", H5P_DEFAULT), H5Dclose);
+    const angio::h5::H5Id space(H5Dget_space(ds), H5Sclose);
+    const std::vector<double> zeros(std::size_t(H5Sget_simple_extent_npoints(space)), 0.0);
+    EXPECT_GE(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, zeros.data()), 0);
+  }
+  MPI_Barrier(PETSC_COMM_WORLD);
+  return copy;
+}
+
 // The first half's state, written once per test process.
 const std::string& first_half_state() {
   static std::string state;
@@ -126,7 +157,7 @@ TEST(StateFile, ContinuedRunEndsWhereTheUninterruptedRunEnds) {
   EXPECT_TRUE(state.has_before);  // prediction: extrapolate keeps the commit before
   EXPECT_NEAR(state.before_time, 0.375, 1e-15);
   double q = 0.0;
-  for (const auto& Q : state.parts[0].Q) q = std::max(q, Q.norm());
+  for (const auto& Q : table<6>(state_path, "parts/artery/viscous_Q")) q = std::max(q, Q.norm());
   EXPECT_GT(q, 1e-4);  // the media's overstress at the end of the ramp (MPa): the history is not trivial
 
   const auto continued =
@@ -140,9 +171,8 @@ TEST(StateFile, ContinuedRunEndsWhereTheUninterruptedRunEnds) {
 
   // the same continuation with the history dropped (a fresh viscous branch) ends elsewhere: the
   // check above sees the history
-  SolidScene sc = read(scene_file("second_half_fresh", "time: {start: 0.5, end: 1.0, steps: 4}", initial()));
-  for (auto& p : sc.initial_state->parts)
-    for (auto& Q : p.Q) Q.setZero();
+  SolidScene sc = read(scene_file("second_half_fresh", "time: {start: 0.5, end: 1.0, steps: 4}",
+                                  "initial_state: {file: " + without_history(state_path) + "}"));
   const auto time = sc.time;
   SolidRunner fresh(PETSC_COMM_WORLD, std::move(sc), "");
   ASSERT_EQ(angio::participant::run_standalone(fresh, time), 0);
@@ -153,18 +183,18 @@ TEST(StateFile, ContinuedRunEndsWhereTheUninterruptedRunEnds) {
 TEST(StateFile, PartsLandOnTheirNodesOthersStartUndeformed) {
   // the artery of the state under a new balloon (the next phase of a procedure)
   SolidScene sc = read(scene_file("with_balloon", "time: {start: 0.5, end: 1.0, steps: 1}", initial("[artery]"), true));
-  const StateFile state = *sc.initial_state;  // a copy: the runner drops its own once applied
+  const auto artery = table<3>(sc.initial_state->path, "parts/artery/displacement");
   SolidRunner runner(PETSC_COMM_WORLD, std::move(sc), "");
   const Mesh& mesh = runner.model().mesh();
   const auto nodes = part_nodes(mesh, "artery");
-  ASSERT_EQ(nodes.size(), state.parts[0].u.size());
+  ASSERT_EQ(nodes.size(), artery.size());
   double diff = 0.0, balloon = 0.0;
   const std::vector<Vec3d> u = runner.model().gather_displacement();
-  for (size_t i = 0; i < nodes.size(); ++i) diff = std::max(diff, (u[nodes[i]] - state.parts[0].u[i]).norm());
+  for (size_t i = 0; i < nodes.size(); ++i) diff = std::max(diff, (u[nodes[i]] - artery[i]).norm());
   for (int n : part_nodes(mesh, "balloon")) balloon = std::max(balloon, u[n].norm());
   EXPECT_EQ(diff, 0.0);
   EXPECT_EQ(balloon, 0.0);
-  EXPECT_GT(state.parts[0].u[0].norm(), 0.0);
+  EXPECT_GT(artery[0].norm(), 0.0);
 }
 
 TEST(StateFile, MismatchesAreSceneErrorsNamingTheKey) {
@@ -190,4 +220,82 @@ TEST(StateFile, MismatchesAreSceneErrorsNamingTheKey) {
             std::string::npos);
   EXPECT_NE(message(scene_file("not_hdf5", t, "initial_state: {file: not_hdf5.yaml}")).find("not an HDF5 file"),
             std::string::npos);
+}
+
+// Exact: the file holds each part's nodes in ascending mesh order (reference coordinates, committed
+// displacement, the commit before) and each element's viscous history in ascending element order,
+// whatever the ranks that wrote it (each rank writes the block of rows it was sent, file_blocks.hpp):
+// a prescribed state written on this test's 1 or 2 ranks reads back bit for bit.
+TEST(StateFile, WrittenByAllRanksInTheMeshOrder) {
+  SolidScene sc = read(scene_file("layout", "", "", true));  // two parts, a viscous media
+  const Mesh mesh = sc.mesh;
+  const std::vector<LayerMaterial> materials = sc.materials;
+  SolidModel model(PETSC_COMM_WORLD, std::move(sc.mesh), sc.materials, sc.options);
+  auto field = [&](double s) {  // a displacement with nothing in common between nodes
+    std::vector<Vec3d> u(mesh.X.size());
+    for (size_t n = 0; n < u.size(); ++n)
+      u[n] = s * Vec3d(std::sin(mesh.X[n](0)), mesh.X[n](1) * mesh.X[n](2), 1e-3 * double(n));
+    return u;
+  };
+  model.start_from(0.75, field(2.0), field(1.0), 0.5);  // no Dirichlet conditions: the model alone
+  auto history = [](int e, int g) {                     // element e's Gauss point g
+    Vec6 q;
+    for (int k = 0; k < 6; ++k) q(k) = double(e) + 0.1 * g + 0.01 * k;
+    return q;
+  };
+  const auto& le = model.local_elements();
+  for (size_t i = 0; i < le.size(); ++i) {
+    const auto v = model.viscous_state(i);
+    for (int g = 0; g < v.points; ++g) {
+      v.Q[g] = history(le[i], g);
+      v.Sv[g] = -history(le[i], g);
+    }
+  }
+  const std::string path = dir_of("layout_state.h5");
+  write_state_file(model, path, 7);
+  const StateFile s = read_state_file(path);
+  EXPECT_EQ(s.time, 0.75);
+  EXPECT_EQ(s.step, 7);
+  ASSERT_TRUE(s.has_before);
+  EXPECT_EQ(s.before_time, 0.5);
+  ASSERT_EQ(s.parts.size(), 2u);
+  const std::vector<Vec3d> u = field(2.0), before = field(1.0);
+  for (const std::string name : {"artery", "balloon"}) {
+    const PartState* p = s.part(name);
+    ASSERT_NE(p, nullptr) << name;
+    const auto nodes = part_nodes(mesh, name);
+    ASSERT_EQ(p->nodes, long(nodes.size())) << name;
+    const auto X = table<3>(path, "parts/" + name + "/coordinates");
+    const auto un = table<3>(path, "parts/" + name + "/displacement");
+    const auto ub = table<3>(path, "parts/" + name + "/displacement_before");
+    ASSERT_EQ(X.size(), nodes.size()) << name;
+    ASSERT_EQ(un.size(), nodes.size()) << name;
+    ASSERT_EQ(ub.size(), nodes.size()) << name;
+    double d = 0.0;
+    for (size_t i = 0; i < nodes.size(); ++i)
+      d = std::max(
+          {d, (X[i] - mesh.X[nodes[i]]).norm(), (un[i] - u[nodes[i]]).norm(), (ub[i] - before[nodes[i]]).norm()});
+    EXPECT_EQ(d, 0.0) << name;
+    const auto elems = part_elements(mesh, name);
+    const auto points = viscous_points(path, name);
+    const auto Q = table<6>(path, "parts/" + name + "/viscous_Q");
+    const auto Sv = table<6>(path, "parts/" + name + "/viscous_Sv");
+    ASSERT_EQ(points.size(), elems.size()) << name;
+    ASSERT_EQ(p->points, long(Q.size())) << name;
+    size_t row = 0, with_history = 0;
+    double dq = 0.0;
+    for (size_t k = 0; k < elems.size(); ++k) {
+      const auto& el = mesh.elements[elems[k]];
+      const int expected = materials[el.block].viscous ? int(volume_rule(el.type).size()) : 0;
+      EXPECT_EQ(points[k], expected) << name << " element " << elems[k];
+      with_history += expected > 0;
+      for (int g = 0; g < points[k]; ++g, ++row) {
+        ASSERT_LT(row, Q.size());
+        dq = std::max({dq, (Q[row] - history(elems[k], g)).norm(), (Sv[row] + history(elems[k], g)).norm()});
+      }
+    }
+    EXPECT_EQ(row, Q.size()) << name;
+    EXPECT_EQ(dq, 0.0) << name;
+    EXPECT_EQ(with_history > 0, name == "artery");  // the media's elements, not the balloon's
+  }
 }

@@ -22,17 +22,20 @@ double weighted_quantile(std::vector<double> values, std::vector<double> weights
 class LumenProfile {
  public:
   LumenProfile() = default;
-  // nodes: endothelium nodes; station: their reference axial coordinate (arc length).
-  LumenProfile(const std::vector<int>& nodes, const std::vector<double>& station, int max_stations);
+  // station: the reference axial coordinate (arc length) of each endothelium node, in the order in
+  // which diameters() gets their positions.
+  LumenProfile(const std::vector<double>& station, int max_stations);
   const std::vector<double>& stations() const { return s_; }  // mean reference station of each group (mm)
-  // x: current positions of all mesh nodes (indexed by mesh node); centroids (optional): each
-  // station's centroid, the deformed lumen centerline a later device is placed on.
+  // x: current positions of the endothelium nodes, in the constructor's order (the lumen's nodes
+  // only: a rank holds those, not the whole mesh); centroids (optional): each station's centroid, the
+  // deformed lumen centerline a later device is placed on.
   std::vector<double> diameters(const std::vector<Vec3d>& x, std::vector<Vec3d>* centroids = nullptr) const;
   bool empty() const { return groups_.empty(); }
 
  private:
   std::vector<double> s_;
-  std::vector<std::vector<int>> groups_;
+  std::vector<std::vector<int>> groups_;  // per station: its nodes' positions in the constructor's list
+  std::size_t nodes_ = 0;                 // the number of endothelium nodes
 };
 
 // Apposition of the stent: gap per strut sample point (distance from the strut surface to the

@@ -1,4 +1,4 @@
-// Collecting per-rank values on rank 0 (summaries, state files).
+// Collecting per-rank values on rank 0 (summaries).
 #pragma once
 #include <mpi.h>
 

@@ -238,10 +238,12 @@ class SolidModel {
 
   // --- the committed state, as state files keep it (state_file.hpp)
   double committed_time() const { return committed_time_; }
-  // Collective: the committed displacement of every node (original index) on rank 0, and the commit
-  // before it (newton.extrapolate) with its time; empty vectors on the other ranks. False: no commit
-  // before (before left empty on every rank).
-  bool gather_committed(std::vector<Vec3d>& u, std::vector<Vec3d>& before, double& before_time) const;
+  // The committed displacement of a node this rank holds (std::out_of_range otherwise); the commit
+  // before it (newton.extrapolate) where has_commit_before() (the same on every rank), at before_time().
+  Vec3d committed_displacement(int node) const { return held_entry_(u_committed_, node); }
+  bool has_commit_before() const { return u_before_.size() == u_committed_.size(); }
+  Vec3d displacement_before(int node) const { return held_entry_(u_before_, node); }
+  double before_time() const { return before_time_; }
   // Viscous history of local element i (local_elements() order): its Gauss points' committed Q and
   // Sv (points = 0: no viscous branch). Writable only between steps, before a solve uses it.
   struct ViscousState {
@@ -250,9 +252,11 @@ class SolidModel {
     Vec6* Sv = nullptr;
   };
   ViscousState viscous_state(size_t i);
-  // Continue from a committed state at time t: u by original node index becomes the committed and
-  // current displacement; u_before (empty: none) the commit before it, at before_time. Prescribed
-  // values are applied at t. The viscous history is set through viscous_state().
+  // Continue from a committed state at time t: u of the held nodes (held_index() order, 3 per node)
+  // becomes the committed and current displacement; u_before (empty: none) the commit before it, at
+  // before_time. Prescribed values are applied at t. The viscous history is set through viscous_state().
+  void start_from_held(double t, std::vector<double> u, std::vector<double> u_before, double before_time);
+  // The same from whole-mesh vectors by original node index (tests, small meshes).
   void start_from(double t, const std::vector<Vec3d>& u, const std::vector<Vec3d>& u_before, double before_time);
 
   // --- access (each rank the displacement of the nodes it holds)
@@ -273,6 +277,7 @@ class SolidModel {
   // rank may pass any nodes, or none). Between solves only: a state() kept before does not fit after.
   void hold_nodes(const std::vector<int>& nodes);
   bool holds(int node) const { return slot_[node] >= 0; }
+  int held_index(int node) const { return slot_[node]; }  // its place among the held nodes (-1: not held)
   int num_held_nodes() const { return int(held_.size()); }
   Vec3d displacement(int node) const;  // of a node this rank holds (std::out_of_range otherwise)
   Vec3d position(int node) const { return mesh_.X[node] + displacement(node); }
@@ -325,8 +330,9 @@ class SolidModel {
   void create_scatter_();
   // The held state's entry of a node's component (the node must be held).
   int ldof_(int node, int comp) const { return 3 * slot_[node] + comp; }
-  // Collective: v (held order) of every node by original index, on every rank (all) or on rank 0 only.
-  std::vector<Vec3d> gather_nodes_(const std::vector<double>& v, bool all) const;
+  // A node's entry of a held state (u_, u_committed_, u_before_); std::out_of_range where this rank
+  // does not hold the node.
+  Vec3d held_entry_(const std::vector<double>& v, int node) const;
   // Faces of surface set `name` assembled by this rank (those whose first node it owns); `what` names the load.
   // Their nodes are held (collective).
   std::vector<Face> owned_faces_(const std::string& name, const char* what);

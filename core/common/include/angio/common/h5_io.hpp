@@ -76,9 +76,8 @@ struct Reader {
     if (a.id < 0 || H5Aread(a, type, &v) < 0) fail(std::string("cannot read attribute ") + name);
     return v;
   }
-  // A [rows, cols] dataset (cols = 1: one-dimensional) of `type`.
-  template <class T>
-  std::vector<T> dataset(hid_t loc, const std::string& name, hid_t type, int cols, hsize_t& rows) const {
+  // The rows of a [rows, cols] dataset (cols = 1: one-dimensional); fails on another shape.
+  hsize_t table_rows(hid_t loc, const std::string& name, int cols) const {
     if (!exists(loc, name)) fail("missing dataset " + name);
     H5Id ds(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
     H5Id space(H5Dget_space(ds), H5Sclose);
@@ -88,10 +87,27 @@ struct Reader {
     H5Sget_simple_extent_dims(space, dims, nullptr);
     if (hsize_t(cols) != (nd == 2 ? dims[1] : 1))
       fail("dataset " + name + ": expected " + std::to_string(cols) + " columns");
-    rows = dims[0];
-    std::vector<T> v(rows * cols);
-    if (rows > 0 && H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) fail("cannot read " + name);
+    return dims[0];
+  }
+  // Rows [start, start + count) of a [rows, cols] dataset of `type` (table_rows() checked first).
+  template <class T>
+  std::vector<T> block(hid_t loc, const std::string& name, hid_t type, int cols, hsize_t start, hsize_t count) const {
+    std::vector<T> v(count * cols);
+    if (count == 0) return v;
+    H5Id ds(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+    H5Id space(H5Dget_space(ds), H5Sclose);
+    const int nd = H5Sget_simple_extent_ndims(space);
+    const hsize_t first[2] = {start, 0}, size[2] = {count, hsize_t(cols)};
+    H5Sselect_hyperslab(space, H5S_SELECT_SET, first, nullptr, size, nullptr);
+    H5Id mem(H5Screate_simple(nd, size, nullptr), H5Sclose);
+    if (H5Dread(ds, type, mem, space, H5P_DEFAULT, v.data()) < 0) fail("cannot read " + name);
     return v;
+  }
+  // A [rows, cols] dataset (cols = 1: one-dimensional) of `type`.
+  template <class T>
+  std::vector<T> dataset(hid_t loc, const std::string& name, hid_t type, int cols, hsize_t& rows) const {
+    rows = table_rows(loc, name, cols);
+    return block<T>(loc, name, type, cols, 0, rows);
   }
   // A [n, N] table of doubles as n vectors; every entry finite.
   template <int N>
