@@ -261,7 +261,10 @@ void check_state(const StateFile& state, const Mesh& mesh, const std::vector<std
   }
 }
 
-void apply_state(SolidModel& model, const StateFile& state, const std::vector<std::string>& parts) {
+namespace {
+// apply_state's reading, on this rank: u and ub (held order) and its elements' viscous history.
+void read_rows(SolidModel& model, const StateFile& state, const std::vector<std::string>& parts, std::vector<double>& u,
+               std::vector<double>& ub) {
   const Mesh& mesh = model.mesh();
   const Reader r{state.path};
   h5::QuietErrors quiet;
@@ -270,8 +273,6 @@ void apply_state(SolidModel& model, const StateFile& state, const std::vector<st
   if (r.attribute<double>(file, "time", H5T_NATIVE_DOUBLE) != state.time ||
       r.attribute<int>(file, "step", H5T_NATIVE_INT) != state.step)
     r.fail("replaced since the scene was read (another time or step): continue from a state file no run writes");
-  // the held nodes' displacement and the commit before (held order; nodes of other parts: none)
-  std::vector<double> u(3 * std::size_t(model.num_held_nodes()), 0.0), ub(state.has_before ? u.size() : 0, 0.0);
   // this rank's elements' viscous history (elements of other parts: none)
   const auto& le = model.local_elements();
   for (std::size_t i = 0; i < le.size(); ++i) {
@@ -327,6 +328,21 @@ void apply_state(SolidModel& model, const StateFile& state, const std::vector<st
                              });
     }
   }
+}
+}  // namespace
+
+void apply_state(SolidModel& model, const StateFile& state, const std::vector<std::string>& parts) {
+  // the held nodes' displacement and the commit before (held order; nodes of other parts: none)
+  std::vector<double> u(3 * std::size_t(model.num_held_nodes()), 0.0), ub(state.has_before ? u.size() : 0, 0.0);
+  std::string error;  // every rank reads the file: one that fails must not go on alone into collective calls
+  try {
+    read_rows(model, state, parts, u, ub);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  int ok = error.empty(), all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, model.comm());
+  if (!all) throw StateFileError(ok ? state.path + ": another rank could not read it" : error);
   model.start_from_held(state.time, std::move(u), std::move(ub), state.before_time);
 }
 
