@@ -1,7 +1,8 @@
 // Solid state files (state_file.hpp): a run continued from the state file of its first half ends
 // where the uninterrupted run ends (consistency: the same committed displacement, viscous history and
 // extrapolation base, so the same equilibria to round-off); a state lands on the parts named and only
-// on the mesh it came from, and every mismatch is a scene error naming the key.
+// on the mesh it came from, and every mismatch is a scene error naming the key; the file written by
+// all ranks together holds every row where the mesh order puts it (exact).
 #include <gtest/gtest.h>
 #include <mpi.h>
 #include <petscsys.h>
