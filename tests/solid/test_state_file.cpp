@@ -299,4 +299,13 @@ TEST(StateFile, WrittenByAllRanksInTheMeshOrder) {
     EXPECT_EQ(dq, 0.0) << name;
     EXPECT_EQ(with_history > 0, name == "artery");  // the media's elements, not the balloon's
   }
+  // the state read back onto the model (its rows, chunk by chunk), and a file replaced between the
+  // check and the reading (a run that still writes it) refused on every rank
+  apply_state(model, s, {"artery", "balloon"});
+  double back = 0.0;
+  for (size_t n = 0; n < mesh.X.size(); ++n)
+    if (model.holds(int(n))) back = std::max(back, (model.committed_displacement(int(n)) - u[n]).norm());
+  EXPECT_EQ(back, 0.0);
+  write_state_file(model, path, 8);
+  EXPECT_THROW(apply_state(model, s, {"artery"}), StateFileError);
 }
