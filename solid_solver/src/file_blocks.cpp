@@ -47,22 +47,23 @@ FileBlock to_file_block(MPI_Comm comm, long total, const std::vector<long>& posi
   MPI_Comm_size(comm, &size);
   MPI_Comm_rank(comm, &rank);
   if (payload_start.size() != position.size() + 1) throw std::logic_error("to_file_block: payload offsets");
-  auto block_begin = [&](int r) { return long((long double)total * r / size); };
-  std::vector<long> bound(size + 1);
-  for (int r = 0; r <= size; ++r) bound[r] = block_begin(r);
+  std::vector<long> bound(size + 1);  // rank r's block: [bound[r], bound[r + 1])
+  for (int r = 0; r <= size; ++r) bound[r] = long((long double)total * r / size);
   // records as [position, length, payload...], grouped by the rank whose block holds them
   std::vector<int> dest(position.size());
+  long values = 0;
   std::vector<int> send_count(size, 0);
   for (std::size_t i = 0; i < position.size(); ++i) {
     const long p = position[i];
     if (p < 0 || p >= total) throw std::logic_error("to_file_block: position out of range");
     dest[i] = int(std::upper_bound(bound.begin(), bound.end(), p) - bound.begin()) - 1;
-    send_count[dest[i]] += int(2 + payload_start[i + 1] - payload_start[i]);
+    const long n = 2 + payload_start[i + 1] - payload_start[i];
+    values += n;
+    if (values > long(std::numeric_limits<int>::max()))  // MPI's counts and offsets are ints
+      throw std::runtime_error("to_file_block: more than 2^31 values from one rank");
+    send_count[dest[i]] += int(n);
   }
   std::vector<int> send_at(size + 1, 0);
-  long sent = 0;  // MPI's counts are ints
-  for (int r = 0; r < size; ++r) sent += send_count[r];
-  if (sent > long(std::numeric_limits<int>::max())) throw std::runtime_error("to_file_block: more than 2^31 values");
   for (int r = 0; r < size; ++r) send_at[r + 1] = send_at[r] + send_count[r];
   std::vector<double> send(std::size_t(send_at[size]));
   std::vector<int> next(send_at.begin(), send_at.end() - 1);

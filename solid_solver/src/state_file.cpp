@@ -23,6 +23,30 @@ int viscous_points_of(const Mesh& mesh, const std::vector<LayerMaterial>& materi
   const auto& el = mesh.elements[e];
   return materials[el.block].viscous ? int(volume_rule(el.type).size()) : 0;
 }
+
+// A part's elements and nodes, ascending: the order of its rows in the file.
+struct PartRows {
+  std::vector<int> elements, nodes;
+};
+PartRows part_rows(const Mesh& mesh, const std::string& part) {
+  PartRows p{part_elements(mesh, part), {}};
+  std::vector<char> in(mesh.X.size(), 0);
+  for (int e : p.elements)
+    for (int a = 0; a < mesh.elements[e].nn(); ++a) in[mesh.elements[e].n[a]] = 1;
+  for (size_t n = 0; n < in.size(); ++n)
+    if (in[n]) p.nodes.push_back(int(n));
+  return p;
+}
+
+// (row in `sorted`, index in `items`) of each of `items` that `sorted` (ascending) holds: where the
+// rows of this rank's nodes or elements sit in a part's table.
+std::vector<std::pair<long, std::size_t>> rows_of(const std::vector<int>& sorted, const std::vector<int>& items) {
+  std::vector<std::pair<long, std::size_t>> out;
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (const auto it = std::lower_bound(sorted.begin(), sorted.end(), items[i]); it != sorted.end() && *it == items[i])
+      out.emplace_back(long(it - sorted.begin()), i);
+  return out;
+}
 }  // namespace
 
 const PartState* StateFile::part(const std::string& name) const {
@@ -38,15 +62,7 @@ std::vector<int> part_elements(const Mesh& mesh, const std::string& part) {
   return elems;
 }
 
-std::vector<int> part_nodes(const Mesh& mesh, const std::string& part) {
-  std::vector<char> in(mesh.X.size(), 0);
-  for (int e : part_elements(mesh, part))
-    for (int a = 0; a < mesh.elements[e].nn(); ++a) in[mesh.elements[e].n[a]] = 1;
-  std::vector<int> nodes;
-  for (size_t n = 0; n < in.size(); ++n)
-    if (in[n]) nodes.push_back(int(n));
-  return nodes;
-}
+std::vector<int> part_nodes(const Mesh& mesh, const std::string& part) { return part_rows(mesh, part).nodes; }
 
 void write_state_file(SolidModel& model, const std::string& path, int step) {
   // Written by all ranks together (MPI-IO), each rank's rows sent to the rank that writes their
@@ -71,14 +87,14 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
     for (const auto& name : part_names(mesh)) {
       const std::string g = "/parts/" + name + "/";
       // the part's nodes this rank owns: reference coordinates, displacement and the one before
-      const auto nodes = part_nodes(mesh, name);
+      const PartRows part = part_rows(mesh, name);
+      std::vector<int> owned;
+      for (int i = model.owned_node_begin(); i < model.owned_node_end(); ++i) owned.push_back(model.old_index(i));
       std::vector<long> position, start{0};
       std::vector<double> rows;
-      for (int i = model.owned_node_begin(); i < model.owned_node_end(); ++i) {
-        const int n = model.old_index(i);
-        const auto it = std::lower_bound(nodes.begin(), nodes.end(), n);
-        if (it == nodes.end() || *it != n) continue;
-        position.push_back(long(it - nodes.begin()));
+      for (const auto& [row, i] : rows_of(part.nodes, owned)) {
+        const int n = owned[i];
+        position.push_back(row);
         const Vec3d u = model.committed_displacement(n);
         rows.insert(rows.end(), mesh.X[n].data(), mesh.X[n].data() + 3);
         rows.insert(rows.end(), u.data(), u.data() + 3);
@@ -89,13 +105,13 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
         start.push_back(long(rows.size()));
       }
       const int width = before ? 9 : 6;
-      FileBlock b = to_file_block(comm, long(nodes.size()), position, start, rows);
+      FileBlock b = to_file_block(comm, long(part.nodes.size()), position, start, rows);
       rows = {};
       std::vector<double> column(3 * std::size_t(b.size()));
       auto write_column = [&](int first, const char* dataset) {  // values first..first+2 of each row
         for (long i = 0; i < b.size(); ++i)
           for (int k = 0; k < 3; ++k) column[3 * i + k] = b.values[std::size_t(width * i + first + k)];
-        write_block_rows(comm, file, g + dataset, H5T_NATIVE_DOUBLE, long(nodes.size()), 3, b.begin, b.size(),
+        write_block_rows(comm, file, g + dataset, H5T_NATIVE_DOUBLE, long(part.nodes.size()), 3, b.begin, b.size(),
                          column.data());
       };
       write_column(0, "coordinates");
@@ -106,19 +122,16 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
         write_attribute(ds, "before_time", H5T_NATIVE_DOUBLE, &before_time);
       }
       // the part's elements this rank assembles: their Gauss points' viscous history (Q, then Sv)
-      const auto elems = part_elements(mesh, name);
       position.clear();
       start.assign(1, 0);
-      for (std::size_t i = 0; i < le.size(); ++i) {
-        const auto it = std::lower_bound(elems.begin(), elems.end(), le[i]);
-        if (it == elems.end() || *it != le[i]) continue;
-        position.push_back(long(it - elems.begin()));
+      for (const auto& [row, i] : rows_of(part.elements, le)) {
+        position.push_back(row);
         const auto v = model.viscous_state(i);
         for (int p = 0; p < v.points; ++p) rows.insert(rows.end(), v.Q[p].data(), v.Q[p].data() + 6);
         for (int p = 0; p < v.points; ++p) rows.insert(rows.end(), v.Sv[p].data(), v.Sv[p].data() + 6);
         start.push_back(long(rows.size()));
       }
-      b = to_file_block(comm, long(elems.size()), position, start, rows);
+      b = to_file_block(comm, long(part.elements.size()), position, start, rows);
       rows = {};
       std::vector<int> points(std::size_t(b.size()));
       long mine = 0, first = 0, all = 0;  // this block's Gauss points, the row of its first, all of them
@@ -126,8 +139,8 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
       MPI_Exscan(&mine, &first, 1, MPI_LONG, MPI_SUM, comm);
       if (model.rank() == 0) first = 0;
       MPI_Allreduce(&mine, &all, 1, MPI_LONG, MPI_SUM, comm);
-      write_block_rows(comm, file, g + "viscous_points", H5T_NATIVE_INT, long(elems.size()), 1, b.begin, b.size(),
-                       points.data());
+      write_block_rows(comm, file, g + "viscous_points", H5T_NATIVE_INT, long(part.elements.size()), 1, b.begin,
+                       b.size(), points.data());
       std::vector<double> Q, Sv;
       Q.reserve(6 * std::size_t(mine));
       Sv.reserve(6 * std::size_t(mine));
@@ -232,7 +245,8 @@ void check_state(const StateFile& state, const Mesh& mesh, const std::vector<std
   for (const auto& name : parts) {
     const PartState* p = state.part(name);
     if (!p) throw StateFileError(state.path + ": has no part '" + name + "'");
-    const auto nodes = part_nodes(mesh, name);
+    const PartRows part = part_rows(mesh, name);
+    const auto& nodes = part.nodes;
     if (nodes.empty()) throw StateFileError(state.path + ": part '" + name + "' is not in this scene's mesh");
     if (long(nodes.size()) != p->nodes)
       throw StateFileError(state.path + ": part '" + name + "' has " + std::to_string(p->nodes) +
@@ -245,7 +259,7 @@ void check_state(const StateFile& state, const Mesh& mesh, const std::vector<std
               throw StateFileError(state.path + ": part '" + name + "' node " + std::to_string(first + long(i)) +
                                    " lies elsewhere in this scene's mesh (a different mesh)");
         });
-    const auto elems = part_elements(mesh, name);
+    const auto& elems = part.elements;
     if (long(elems.size()) != p->elements)
       throw StateFileError(state.path + ": part '" + name + "' has " + std::to_string(p->elements) +
                            " elements, this scene's mesh " + std::to_string(elems.size()));
@@ -283,47 +297,44 @@ void read_rows(SolidModel& model, const StateFile& state, const std::vector<std:
   for (const auto& name : parts) {
     const PartState* p = state.part(name);
     H5Id g(open_part(r, file, name), H5Gclose);
-    const auto nodes = part_nodes(mesh, name);
+    const PartRows part = part_rows(mesh, name);
     auto take = [&](const char* table, std::vector<double>& into) {  // the held nodes' rows of a table
       for_each_chunk<double>(r, g, table, H5T_NATIVE_DOUBLE, 3, p->nodes,
                              [&](long first, const std::vector<double>& v) {
                                for (std::size_t i = 0; 3 * i < v.size(); ++i)
-                                 if (const int h = model.held_index(nodes[first + i]); h >= 0)
+                                 if (const int h = model.held_index(part.nodes[first + i]); h >= 0)
                                    std::copy_n(v.begin() + 3 * i, 3, into.begin() + 3 * h);
                              });
     };
     take("displacement", u);
     if (state.has_before) take(r.exists(g, "displacement_before") ? "displacement_before" : "displacement", ub);
     // the Gauss points of this rank's elements of the part, by their row in viscous_Q and viscous_Sv
-    const auto elems = part_elements(mesh, name);
-    std::vector<long> want;  // positions in elems of this rank's elements (ascending, as le is)
-    std::vector<std::size_t> local;
-    for (std::size_t i = 0; i < le.size(); ++i)
-      if (const auto it = std::lower_bound(elems.begin(), elems.end(), le[i]); it != elems.end() && *it == le[i]) {
-        want.push_back(long(it - elems.begin()));
-        local.push_back(i);
-      }
-    std::vector<std::pair<long, std::size_t>> rows;  // (row, local element) per Gauss point, ascending row
+    const auto want = rows_of(part.elements, le);  // (element row, local element), ascending
+    struct Point {
+      long row;           // in viscous_Q and viscous_Sv
+      std::size_t local;  // the element's index in local_elements()
+      int point;          // the Gauss point's index in the element
+    };
+    std::vector<Point> points;  // ascending row
     long row = 0;
     std::size_t next = 0;
     for_each_chunk<int>(r, g, "viscous_points", H5T_NATIVE_INT, 1, p->elements,
-                        [&](long first, const std::vector<int>& points) {
-                          for (std::size_t k = 0; k < points.size(); row += points[k], ++k)
-                            if (next < want.size() && want[next] == first + long(k)) {
-                              for (int q = 0; q < points[k]; ++q) rows.emplace_back(row + q, local[next]);
+                        [&](long first, const std::vector<int>& n) {
+                          for (std::size_t k = 0; k < n.size(); row += n[k], ++k)
+                            if (next < want.size() && want[next].first == first + long(k)) {
+                              for (int q = 0; q < n[k]; ++q) points.push_back({row + q, want[next].second, q});
                               ++next;
                             }
                         });
     for (const bool is_q : {true, false}) {
-      std::size_t at = 0, seen = 0;  // the next Gauss point to fill; its place in its element
+      std::size_t at = 0;  // the next Gauss point to fill
       for_each_chunk<double>(r, g, is_q ? "viscous_Q" : "viscous_Sv", H5T_NATIVE_DOUBLE, 6, p->points,
                              [&](long first, const std::vector<double>& v) {
                                const long end = first + long(v.size() / 6);
-                               for (; at < rows.size() && rows[at].first < end; ++at) {
-                                 const auto s = model.viscous_state(rows[at].second);
-                                 seen = at > 0 && rows[at - 1].second == rows[at].second ? seen + 1 : 0;
-                                 Vec6& dst = is_q ? s.Q[seen] : s.Sv[seen];
-                                 for (int c = 0; c < 6; ++c) dst(c) = v[std::size_t(6 * (rows[at].first - first) + c)];
+                               for (; at < points.size() && points[at].row < end; ++at) {
+                                 const auto s = model.viscous_state(points[at].local);
+                                 Vec6& dst = is_q ? s.Q[points[at].point] : s.Sv[points[at].point];
+                                 for (int c = 0; c < 6; ++c) dst(c) = v[std::size_t(6 * (points[at].row - first) + c)];
                                }
                              });
     }
