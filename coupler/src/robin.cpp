@@ -22,7 +22,8 @@ void Robin::set_planes_per_point_(std::size_t K) {
   p_.s = p_.n = Eigen::VectorXd::Zero(3 * K * n_);
   p_.eps = Eigen::VectorXd::Zero(K * n_);  // no planes before the solid has answered once
   p_tilde_ = p_last_ = p_before_ = reply_ = first_ = accepted_reply_ = p_;
-  k_ = f_first_ = f_reply_ = Eigen::VectorXd::Zero(K * n_);
+  k_ = k_last_ = k_before_ = f_first_ = f_reply_ = Eigen::VectorXd::Zero(K * n_);
+  k_surface_.assign(K, 0.0);
 }
 
 void Robin::begin_step(double increment, bool extrapolate) {
@@ -32,7 +33,9 @@ void Robin::begin_step(double increment, bool extrapolate) {
   if (!(extrapolate && dt_last_ > 0.0)) return;
   const double f = increment / dt_last_;
   for (Eigen::Index i = 0; i < p_.eps.size(); ++i)
-    if (p_last_.eps[i] > 0.0 && p_before_.eps[i] > 0.0) {
+    // not across a change from a bare to a softened plane (or back): their difference is the
+    // softening's own shift f/k, and extrapolated it took the wall's planes away from the struts
+    if (p_last_.eps[i] > 0.0 && p_before_.eps[i] > 0.0 && (k_last_[i] > 0.0) == (k_before_[i] > 0.0)) {
       // plane offset extrapolated along the current normal
       const Eigen::Vector3d n = p_last_.n.segment<3>(3 * i);
       const double d = n.dot(p_last_.s.segment<3>(3 * i) - p_before_.s.segment<3>(3 * i));
@@ -70,10 +73,20 @@ Eigen::VectorXd Robin::loads_of(const Planes& p, const Eigen::VectorXd& f, std::
   return q;
 }
 
+double Robin::stiffness_(Eigen::Index j) const {
+  const double median = k_surface_[std::size_t(j) % K_];
+  if (!(median > 0.0)) return k_[j];
+  if (!(k_[j] > 0.0)) return median;
+  // Within a decade of the surface's median: on the post-dilated wall the secants spread over
+  // 0.01-12 N/mm^2 about a median of 0.2-0.6, and a plane softened with 0.01 would sit f/k, up to
+  // 10 mm, behind the wall. (Measured together with the median fallback, not apart.)
+  return std::clamp(k_[j], 0.1 * median, 10.0 * median);
+}
+
 Robin::Planes Robin::softened_(const participant::SamplePoints& x, const Planes& p, const Eigen::VectorXd& f) const {
   Planes b = p;
   for (Eigen::Index j = 0; j < p.eps.size(); ++j) {
-    const double eps = p.eps[j], k = k_[j];
+    const double eps = p.eps[j], k = stiffness_(j);
     if (!(eps > 0.0) || !(k > 0.0)) continue;
     // the series spring of penalty and surface, placed where the unloaded surface would be: it
     // carries the plane's load f_j at x (penalty_gap inverts the law for the new penalty). Taken
@@ -109,6 +122,23 @@ void Robin::update_stiffness_() {
     if (!(std::abs(df) > 0.1 * std::max(f_reply_[j], f_first_[j])) || !(df * dd < 0.0)) continue;
     const double k = std::clamp(-df / dd, 1e-3 * eps, 1e3 * eps);
     k_[j] = k_[j] > 0.0 ? std::sqrt(k_[j] * k) : k;  // geometric mean with the last estimate: less noise
+  }
+  // A plane whose own secant never qualified takes its surface's median estimate. A wall that bears
+  // on the stent while the balloon pushes elsewhere changes its load by a few per cent per step, so
+  // most of its planes would otherwise keep the bare penalty (50x its stiffness: the struts creep
+  // into it over 10 coupling iterations per step).
+  std::vector<double> ks;
+  for (std::size_t s = 0; s < K_; ++s) {
+    ks.clear();
+    for (std::size_t j = s; j < std::size_t(k_.size()); j += K_)
+      if (k_[Eigen::Index(j)] > 0.0) ks.push_back(k_[Eigen::Index(j)]);
+    k_surface_[s] = 0.0;
+    if (ks.size() >= min_estimates_for_median) {
+      std::nth_element(ks.begin(), ks.begin() + std::ptrdiff_t(ks.size() / 2), ks.end());
+      k_surface_[s] = ks[ks.size() / 2];
+    }
+    LOG_DEBUG("robin: surface " << s << ": " << ks.size() << " stiffness estimates, median " << k_surface_[s]
+                                << " N/mm^2");
   }
 }
 
@@ -198,6 +228,8 @@ void Robin::reject() {
   // contact set changed (a wall coming to rest on the stent) can be far too low, and the beam then
   // overshoots at every iteration of every attempt. Estimates start again from the next step.
   k_.setZero();
+  k_last_.setZero();  // p_last_ becomes a bare plane
+  std::fill(k_surface_.begin(), k_surface_.end(), 0.0);
   p_last_ = accepted_reply_;
   dt_last_ = 0.0;  // no extrapolation between a soft and a plain plane
 }
@@ -211,6 +243,8 @@ void Robin::accept(double increment) {
     p_tilde_ = softened_(x_, reply_, f_reply_);
   }
   p_before_ = p_last_;
+  k_before_ = k_last_;
+  for (Eigen::Index j = 0; j < k_last_.size(); ++j) k_last_[j] = compliance_ ? stiffness_(j) : 0.0;
   p_last_ = p_tilde_;
   c_last_ = c_tilde_;
   dt_last_ = increment;

@@ -27,7 +27,7 @@ struct SpringBeam : participant::BeamParticipant {
   int step = 0, accepted = 0, rejected = 0;
   bool failed_once = false;
 
-  SpringBeam() : x(n, x0), x_committed(n, x0) {}
+  explicit SpringBeam(int points = 4) : n(points), x(n, x0), x_committed(n, x0) {}
   participant::SamplePoints sample_points() const override {
     participant::SamplePoints p;
     for (int i = 0; i < n; ++i) {

@@ -19,10 +19,14 @@
 // own load (the secant −Δf_j/Δd_j of its force and its offset along the normal between the first
 // and the last coupling iteration of an accepted step, smoothed over steps), and the iterate is the
 // series spring of penalty and surface, ε' = ε k/(ε + k), at the unloaded surface (the reply's plane
-// moved along n so that at the beam's positions it carries the reply's load). The beam then sees
+// moved along n so that at the beam's positions it carries the reply's load). A plane whose load
+// never changed enough for a secant of its own takes its surface's median estimate (a wall that
+// bears on struts where the balloon does not press would otherwise keep the bare penalty). The beam then sees
 // the interface's tangent in this diagonal model; the map stays a function of the iterate (IQN's
 // secants hold) and at the fixed point both laws carry the solid's load.
 #pragma once
+
+#include <vector>
 
 #include "angio/coupler/interface_scheme.hpp"
 
@@ -51,8 +55,11 @@ class Robin : public InterfaceScheme {
   // Σ line loads f_j n_j of the planes with forces f per point (N/mm, 3 per point).
   static Eigen::VectorXd loads_of(const Planes& p, const Eigen::VectorXd& f, std::size_t n_points);
   // With surface compliance: the planes p (forces f at x) as series springs of penalty and surface
-  // at the unloaded surface; planes without an estimate stay as they are.
+  // at the unloaded surface, each with stiffness_(j); planes with none stay as they are.
   Planes softened_(const participant::SamplePoints& x, const Planes& p, const Eigen::VectorXd& f) const;
+  // The stiffness plane j is softened with: its own estimate within a decade of its surface's
+  // median, the median where it has none; 0 (not softened) before a surface has a median.
+  double stiffness_(Eigen::Index j) const;
   // Surface stiffness per plane from this step's first and last replies (secant), at accept.
   void update_stiffness_();
   // p_tilde_: the last reply as an iterate (softened with surface compliance), reply_: as the solid
@@ -60,6 +67,10 @@ class Robin : public InterfaceScheme {
   Planes p_, p_tilde_, p_last_, p_before_, reply_, first_, accepted_reply_;
   bool compliance_ = false;
   Eigen::VectorXd k_;                  // per plane: surface stiffness estimate (N/mm²), 0 unknown
+  std::vector<double> k_surface_;      // per contact surface: median of k_ (planes without their own)
+  Eigen::VectorXd k_last_, k_before_;  // per plane: the stiffness p_last_ / p_before_ were softened with
+  // fewer estimates than this on a surface: no median (one plane's secant is noise, not a surface)
+  static constexpr std::size_t min_estimates_for_median = 10;
   Eigen::VectorXd f_first_, f_reply_;  // plane forces of first_ and reply_
   Eigen::VectorXd f_previous_;         // plane forces of the reply before (the debug log's switches)
   participant::SamplePoints x_;        // positions of the last reply
