@@ -244,7 +244,7 @@ void Robin::accept(double increment) {
   }
   p_before_ = p_last_;
   k_before_ = k_last_;
-  for (Eigen::Index j = 0; j < k_last_.size(); ++j) k_last_[j] = compliance_ ? stiffness_(j) : 0.0;
+  for (Eigen::Index j = 0; j < k_last_.size(); ++j) k_last_[j] = stiffness_(j);  // 0 without compliance
   p_last_ = p_tilde_;
   c_last_ = c_tilde_;
   dt_last_ = increment;

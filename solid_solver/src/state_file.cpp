@@ -84,12 +84,12 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
     const bool before = model.has_commit_before();
     const double before_time = model.before_time();
     const auto& le = model.local_elements();
+    std::vector<int> owned;  // this rank's owned nodes (mesh numbers)
+    for (int i = model.owned_node_begin(); i < model.owned_node_end(); ++i) owned.push_back(model.old_index(i));
     for (const auto& name : part_names(mesh)) {
       const std::string g = "/parts/" + name + "/";
       // the part's nodes this rank owns: reference coordinates, displacement and the one before
       const PartRows part = part_rows(mesh, name);
-      std::vector<int> owned;
-      for (int i = model.owned_node_begin(); i < model.owned_node_end(); ++i) owned.push_back(model.old_index(i));
       std::vector<long> position, start{0};
       std::vector<double> rows;
       for (const auto& [row, i] : rows_of(part.nodes, owned)) {

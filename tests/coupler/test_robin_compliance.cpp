@@ -82,7 +82,7 @@ TEST(RobinCompliance, PlanesWithoutTheirOwnSecantTakeTheSurfacesMedian) {
     const double softened = eps * k / (eps + k);
     for (std::size_t i = 0; i < std::size_t(n); ++i) {
       const bool own = int(i) < estimated;
-      EXPECT_NEAR(beam.last.eps[i], own || estimated >= 10 ? softened : eps, 1e-9)
+      EXPECT_NEAR(beam.last.eps[i], own || estimated >= 10 ? softened : eps, 1e-12)
           << "plane " << i << " with " << estimated << " estimates";
     }
   }
