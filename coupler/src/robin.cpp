@@ -22,7 +22,9 @@ void Robin::set_planes_per_point_(std::size_t K) {
   p_.s = p_.n = Eigen::VectorXd::Zero(3 * K * n_);
   p_.eps = Eigen::VectorXd::Zero(K * n_);  // no planes before the solid has answered once
   p_tilde_ = p_last_ = p_before_ = reply_ = first_ = accepted_reply_ = p_;
-  k_ = k_last_ = k_before_ = f_first_ = f_reply_ = Eigen::VectorXd::Zero(K * n_);
+  k_ = f_first_ = f_reply_ = Eigen::VectorXd::Zero(K * n_);
+  softened_last_.assign(K * n_, false);
+  softened_before_ = softened_last_;
   k_surface_.assign(K, 0.0);
 }
 
@@ -35,7 +37,8 @@ void Robin::begin_step(double increment, bool extrapolate) {
   for (Eigen::Index i = 0; i < p_.eps.size(); ++i)
     // not across a change from a bare to a softened plane (or back): their difference is the
     // softening's own shift f/k, and extrapolated it took the wall's planes away from the struts
-    if (p_last_.eps[i] > 0.0 && p_before_.eps[i] > 0.0 && (k_last_[i] > 0.0) == (k_before_[i] > 0.0)) {
+    if (p_last_.eps[i] > 0.0 && p_before_.eps[i] > 0.0 &&
+        softened_last_[std::size_t(i)] == softened_before_[std::size_t(i)]) {
       // plane offset extrapolated along the current normal
       const Eigen::Vector3d n = p_last_.n.segment<3>(3 * i);
       const double d = n.dot(p_last_.s.segment<3>(3 * i) - p_before_.s.segment<3>(3 * i));
@@ -228,7 +231,7 @@ void Robin::reject() {
   // contact set changed (a wall coming to rest on the stent) can be far too low, and the beam then
   // overshoots at every iteration of every attempt. Estimates start again from the next step.
   k_.setZero();
-  k_last_.setZero();  // p_last_ becomes a bare plane
+  std::fill(softened_last_.begin(), softened_last_.end(), false);  // p_last_ becomes a bare plane
   std::fill(k_surface_.begin(), k_surface_.end(), 0.0);
   p_last_ = accepted_reply_;
   dt_last_ = 0.0;  // no extrapolation between a soft and a plain plane
@@ -243,8 +246,9 @@ void Robin::accept(double increment) {
     p_tilde_ = softened_(x_, reply_, f_reply_);
   }
   p_before_ = p_last_;
-  k_before_ = k_last_;
-  for (Eigen::Index j = 0; j < k_last_.size(); ++j) k_last_[j] = stiffness_(j);  // 0 without compliance
+  softened_before_ = softened_last_;
+  for (std::size_t j = 0; j < softened_last_.size(); ++j)
+    softened_last_[j] = stiffness_(Eigen::Index(j)) > 0.0;  // never without compliance
   p_last_ = p_tilde_;
   c_last_ = c_tilde_;
   dt_last_ = increment;

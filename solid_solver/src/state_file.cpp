@@ -85,6 +85,7 @@ void write_state_file(SolidModel& model, const std::string& path, int step) {
     const double before_time = model.before_time();
     const auto& le = model.local_elements();
     std::vector<int> owned;  // this rank's owned nodes (mesh numbers)
+    owned.reserve(std::size_t(model.owned_node_end() - model.owned_node_begin()));
     for (int i = model.owned_node_begin(); i < model.owned_node_end(); ++i) owned.push_back(model.old_index(i));
     for (const auto& name : part_names(mesh)) {
       const std::string g = "/parts/" + name + "/";

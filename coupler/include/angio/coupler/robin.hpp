@@ -66,9 +66,9 @@ class Robin : public InterfaceScheme {
   // sent it; first_: the step's first reply (for the secant).
   Planes p_, p_tilde_, p_last_, p_before_, reply_, first_, accepted_reply_;
   bool compliance_ = false;
-  Eigen::VectorXd k_;                  // per plane: surface stiffness estimate (N/mm²), 0 unknown
-  std::vector<double> k_surface_;      // per contact surface: median of k_ (planes without their own)
-  Eigen::VectorXd k_last_, k_before_;  // per plane: the stiffness p_last_ / p_before_ were softened with
+  Eigen::VectorXd k_;                                  // per plane: surface stiffness estimate (N/mm²), 0 unknown
+  std::vector<double> k_surface_;                      // per contact surface: median of k_ (planes without their own)
+  std::vector<bool> softened_last_, softened_before_;  // per plane: p_last_ / p_before_ a softened plane
   // fewer estimates than this on a surface: no median (one plane's secant is noise, not a surface)
   static constexpr std::size_t min_estimates_for_median = 10;
   Eigen::VectorXd f_first_, f_reply_;  // plane forces of first_ and reply_
