@@ -113,6 +113,27 @@ participant::SolveStats BeamSolverParticipant::solve_with_planes(const std::vect
   return solve_loads_(q);
 }
 
+participant::SolveStats BeamSolverParticipant::linear_response(const std::vector<double>& shift,
+                                                               std::vector<participant::Vec3>& dx) {
+  BeamModel& m = *scene_.model;
+  participant::SolveStats out;
+  dx.clear();
+  if (m.sample_planes().empty() || shift.size() != m.sample_planes().size()) {
+    out.message =
+        "a linearized response needs the planes of a solve before it: " + std::to_string(m.sample_planes().size()) +
+        " planes, " + std::to_string(shift.size()) + " shifts";
+    return out;
+  }
+  try {
+    for (const Vec3& d : m.plane_response(shift)) dx.push_back({d.x(), d.y(), d.z()});
+  } catch (const std::exception& e) {
+    out.message = std::string("beam linearized response at step ") + std::to_string(step_) + ": " + e.what();
+    return out;
+  }
+  out.converged = true;
+  return out;
+}
+
 participant::SolveStats BeamSolverParticipant::solve(const std::vector<participant::Vec3>& q) {
   scene_.model->set_sample_planes({});
   return solve_loads_(q);

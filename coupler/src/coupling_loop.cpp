@@ -51,6 +51,17 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
     scheme->seed(points, reply);
     LOG_INFO("interface state recomputed at t = " << time.start << " s from the participants' committed states");
   }
+  // newton-krylov: products of the map's Jacobian through the participants' linearizations
+  int products = 0;
+  double product_time = 0.0;
+  if (acc.uses_jacobian())
+    acc.set_jacobian([&](const Eigen::VectorXd& v) {
+      const auto t0 = Clock::now();
+      Eigen::VectorXd jv = scheme->map_derivative(beam, solid, v);
+      ++products;
+      product_time += seconds_since(t0);
+      return jv;
+    });
   auto step_start = Clock::now();
   // A step whose first coupling iteration fails in a participant from the extrapolated iterate (e.g.
   // the extrapolated contact planes push struts into the wall and the beam's or the solid's Newton
@@ -148,8 +159,12 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
         stalled = true;
         break;
       }
+      const int products_before = products;
+      const double product_time_before = product_time;
       scheme->next_iterate(acc, k - k_restart);
       rep.omega = acc.last_factor();
+      rep.products += products - products_before;
+      rep.product_time += product_time - product_time_before;
     }
 
     run.beam_time += rep.beam_time;  // every attempt: a rejected one cost its solves too

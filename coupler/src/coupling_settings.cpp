@@ -2,6 +2,7 @@
 
 #include "angio/coupler/aitken.hpp"
 #include "angio/coupler/iqn_imvj.hpp"
+#include "angio/coupler/newton_krylov.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -33,6 +34,15 @@ CouplingSettings coupling_settings(const scene::Node& root) {
     s.iqn.stagnation = iqn->get<double>("stagnation");
   }
   s.iqn.initial_relaxation = s.initial_relaxation;
+  if (s.acceleration == "newton-krylov" && s.scheme != "robin")
+    c->child("acceleration").fail("another acceleration (newton-krylov needs coupling.scheme: robin)");
+  if (auto nk = c->optional("newton_krylov")) {
+    if (s.acceleration != "newton-krylov")
+      nk->fail("no newton_krylov section (it applies only with coupling.acceleration: newton-krylov)");
+    nk->check_keys();
+    s.newton_krylov.max_products = nk->get<int>("max_products");
+    s.newton_krylov.tolerance = nk->get<double>("tolerance");
+  }
   s.max_iterations = c->get<int>("max_iterations");
   // below 1 (declared range): rel_tol 1 accepts a residual as large as the contact loads themselves,
   // every first iteration passes and the coupling does nothing (the solid's atol has the like check)
@@ -71,6 +81,8 @@ std::string settings_json(const CouplingSettings& s) {
                 {"max_columns", s.iqn.max_columns},
                 {"filter", s.iqn.filter},
                 {"stagnation", s.iqn.stagnation}};
+  if (s.acceleration == "newton-krylov")
+    j["newton_krylov"] = {{"max_products", s.newton_krylov.max_products}, {"tolerance", s.newton_krylov.tolerance}};
   return j.dump();
 }
 
@@ -78,6 +90,7 @@ std::unique_ptr<Acceleration> make_acceleration(const CouplingSettings& s) {
   if (s.acceleration == "constant") return std::make_unique<ConstantRelaxation>(s.initial_relaxation);
   if (s.acceleration == "iqn-ils") return std::make_unique<IqnIls>(s.iqn);
   if (s.acceleration == "iqn-imvj") return std::make_unique<IqnImvj>(s.iqn);
+  if (s.acceleration == "newton-krylov") return std::make_unique<NewtonKrylov>(s.newton_krylov);
   return std::make_unique<Aitken>(s.initial_relaxation, s.max_relaxation);
 }
 

@@ -168,8 +168,8 @@ Eigen::VectorXd Robin::force_residual(const participant::SamplePoints& x, const 
   // the remainder; softened planes carry the same loads at x, so it holds for either
   c_tilde_ = q_tilde - loads_of(reply_, f_reply_, n);
   p_tilde_ = reply_;
+  x_ = x;
   if (compliance_) {
-    x_ = x;
     if (!have_first_) {
       first_ = reply_;
       f_first_ = f_reply_;
@@ -223,6 +223,40 @@ void Robin::next_iterate(Acceleration& acc, int k) {
   p_.eps = p_tilde_.eps;
   p_.g0 = p_tilde_.g0;
   c_ = c_tilde_;
+}
+
+Eigen::VectorXd Robin::map_derivative(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
+                                      const Eigen::VectorXd& v) {
+  // v moves the planes the beam solved with (p_); only their normal part moves a plane
+  const Eigen::Index m = p_.eps.size();
+  std::vector<double> shift(std::size_t(m), 0.0);
+  for (Eigen::Index j = 0; j < m; ++j)
+    if (p_.eps[j] > 0.0) shift[std::size_t(j)] = p_.n.segment<3>(3 * j).dot(v.segment<3>(3 * j));
+  std::vector<participant::Vec3> dx;
+  if (!beam.linear_response(shift, dx).converged || dx.size() != n_) return {};
+  std::vector<double> ds;
+  if (!solid.linear_response(dx, ds).converged || ds.size() != std::size_t(m)) return {};
+  // The solid's planes (reply_) move by ds along their normals and the points by dx; the iterate
+  // made of them (softened with surface compliance: a function of both) by forward differences,
+  // exact where the penalty law is linear.
+  double amax = 0.0;
+  for (const auto& d : dx) amax = std::max({amax, std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
+  for (double d : ds) amax = std::max(amax, std::abs(d));
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(p_.s.size());
+  if (!(amax > 0.0)) return out;
+  const double h = 1e-6 / amax;
+  participant::SamplePoints x1 = x_;
+  for (std::size_t i = 0; i < n_; ++i)
+    for (int c = 0; c < 3; ++c) x1.x[i][c] += h * dx[i][c];
+  Planes r1 = reply_;
+  for (Eigen::Index j = 0; j < m; ++j) r1.s.segment<3>(3 * j) += h * ds[std::size_t(j)] * reply_.n.segment<3>(3 * j);
+  const Planes t1 = compliance_ ? softened_(x1, r1, plane_forces(x1, r1)) : r1;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    if (!(p_tilde_.eps[j] > 0.0)) continue;
+    const Eigen::Vector3d n = p_tilde_.n.segment<3>(3 * j);
+    out.segment<3>(3 * j) = n.dot(t1.s.segment<3>(3 * j) - p_tilde_.s.segment<3>(3 * j)) / h * n;
+  }
+  return out;
 }
 
 void Robin::reject() {

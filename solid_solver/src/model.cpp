@@ -1143,6 +1143,30 @@ void SolidModel::element_stress(std::vector<double>& p1, std::vector<Vec3d>& dir
   }
 }
 
+std::string SolidModel::tangent_response(const std::vector<Vec3d>& f, std::vector<double>& du) {
+  if (f.size() != std::size_t(node_end_ - node_begin_))
+    throw std::logic_error("tangent_response: forces for another number of owned nodes");
+  if (!splits_ready_) return "no tangent factorized yet";
+  // r_ and du_ are the Newton's scratch: the next solve assembles r_ again before it reads it
+  PetscScalar* a;
+  ANGIO_PETSC(VecGetArray(r_, &a));
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (int c = 0; c < 3; ++c) a[3 * i + c] = f[i][c];
+  for (PetscInt row : dirichlet_rows_) a[row - 3 * node_begin_] = 0.0;
+  ANGIO_PETSC(VecRestoreArray(r_, &a));
+  ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+  if (!kept_splits_.empty()) keep_splits_(true);
+  KSPConvergedReason reason;
+  {
+    OptionsScope scope(options_);
+    ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
+  }
+  ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
+  if (reason < 0 && reason != KSP_DIVERGED_ITS) return std::string("linear solver: ") + KSPConvergedReasons[reason];
+  gather_(du_, du);
+  return {};
+}
+
 std::vector<Vec3d> SolidModel::contact_forces(ContactModel& c) {
   Vec f;
   ANGIO_PETSC(VecDuplicate(r_, &f));

@@ -171,6 +171,7 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
                                            double tolerance) {
   if (stent_contact_) stent_contact_->set_points(pts);
   stent_x_ = pts.x;
+  points_ = pts;
   if (!pts.x.empty() && !stent_contact_ && !warned_contact_ && rank_ == 0) {
     LOG_WARN("solid: no stent contact configured; " << pts.x.size()
                                                     << " beam sample points are ignored (zero line loads)");
@@ -208,6 +209,71 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
     s.message = last_.message;
   }
   return s;
+}
+
+participant::SolveStats SolidRunner::linear_response(const std::vector<participant::Vec3>& dx,
+                                                     std::vector<double>& plane_shift) {
+  participant::SolveStats out;
+  plane_shift.clear();
+  StentContact* line = stent_contact_ ? stent_contact_->line_part() : nullptr;
+  if (!line || dx.size() != points_.size() || points_.x.empty() || !last_.converged) {
+    out.message = "a linearized response needs a converged solve with the stent's " + std::to_string(points_.size()) +
+                  " sample points before it (got " + std::to_string(dx.size()) + " displacements" +
+                  (line ? ")" : ", and this solid has no stent contact)");
+    return out;
+  }
+  double dmax = 0.0;
+  for (const auto& d : dx) dmax = std::max({dmax, std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
+  // Central differences of the contact forces in the points, and forward ones of the planes in the
+  // points and the displacement together: exact for the linear penalty law away from its switches;
+  // 1e-6 mm against positions of order 1 mm leaves round-off of about 1e-10 relative.
+  const double h = dmax > 0.0 ? 1e-6 / dmax : 0.0;
+  auto moved = [&](double a) {
+    participant::SamplePoints p = points_;
+    for (std::size_t i = 0; i < p.x.size(); ++i)
+      for (int c = 0; c < 3; ++c) p.x[i][c] += a * h * dx[i][c];
+    return p;
+  };
+  participant::ContactReply base, shifted;
+  reset_reply(points_, base);
+  line->fill_reply(*model_, base);  // the solve's last evaluation when it saw this configuration
+  const std::vector<double> u0 = model_->state();
+  std::string failed;
+  if (h > 0.0) {
+    line->set_points(moved(1.0));
+    std::vector<Vec3d> f = model_->contact_forces(*line);
+    line->set_points(moved(-1.0));
+    const std::vector<Vec3d> fm = model_->contact_forces(*line);
+    for (std::size_t i = 0; i < f.size(); ++i) f[i] = (f[i] - fm[i]) / (2.0 * h);  // forces on the solid: K du = df
+    std::vector<double> du;
+    failed = model_->tangent_response(f, du);
+    if (failed.empty()) {
+      std::vector<double> u1 = u0;
+      for (std::size_t i = 0; i < u1.size(); ++i) u1[i] += h * du[i];
+      model_->restore_state(u1);
+      line->set_points(moved(1.0));
+      reset_reply(points_, shifted);
+      line->fill_reply(*model_, shifted);
+    }
+    model_->restore_state(u0);
+    line->set_points(points_);
+  }
+  if (!failed.empty()) {
+    out.message = "solid linearized response at step " + std::to_string(step_) + ": " + failed;
+    return out;
+  }
+  out.converged = true;
+  if (rank_ != 0) return out;
+  plane_shift.assign(base.penalty.size(), 0.0);
+  if (h > 0.0)
+    for (std::size_t j = 0; j < plane_shift.size(); ++j) {
+      if (!(base.penalty[j] > 0.0) || !(shifted.penalty[j] > 0.0)) continue;  // a plane in range at both ends
+      const auto& n = base.normals[j];
+      double d = 0.0;
+      for (int c = 0; c < 3; ++c) d += n[c] * (shifted.surface_points[j][c] - base.surface_points[j][c]);
+      plane_shift[j] = d / h;
+    }
+  return out;
 }
 
 SolveReport SolidRunner::continuation_(const participant::SamplePoints& pts, const std::vector<double>& u_start,
@@ -678,7 +744,7 @@ void SolidRunner::finish() {
 
 // ---------------------------------------------------------------------------------------------
 namespace {
-enum Cmd : int { kBegin = 1, kSolve = 2, kEnd = 3, kFinish = 4 };
+enum Cmd : int { kBegin = 1, kSolve = 2, kEnd = 3, kFinish = 4, kLinear = 5 };
 
 void bcast_points(participant::SamplePoints& p, MPI_Comm comm) {
   long n = long(p.x.size());
@@ -711,6 +777,17 @@ participant::SolveStats MpiSolidParticipant::solve(const participant::SamplePoin
   if (p.radius.size() != p.x.size()) p.radius.resize(p.x.size(), 0.0);
   bcast_points(p, comm_);
   return inner_.solve(p, reply, tolerance);
+}
+
+participant::SolveStats MpiSolidParticipant::linear_response(const std::vector<participant::Vec3>& dx,
+                                                             std::vector<double>& plane_shift) {
+  int cmd = kLinear;
+  MPI_Bcast(&cmd, 1, MPI_INT, 0, comm_);
+  std::vector<participant::Vec3> d = dx;
+  long n = long(d.size());
+  MPI_Bcast(&n, 1, MPI_LONG, 0, comm_);
+  if (n > 0) MPI_Bcast(d.data(), int(3 * n), MPI_DOUBLE, 0, comm_);
+  return inner_.linear_response(d, plane_shift);
 }
 
 void MpiSolidParticipant::end_step(bool accept) {
@@ -750,6 +827,15 @@ int run_follower(participant::SolidParticipant& inner, MPI_Comm comm) {
         bcast_points(p, comm);
         participant::ContactReply reply;
         inner.solve(p, reply, tolerance);
+        break;
+      }
+      case kLinear: {
+        long n = 0;
+        MPI_Bcast(&n, 1, MPI_LONG, 0, comm);
+        std::vector<participant::Vec3> d(static_cast<std::size_t>(n));
+        if (n > 0) MPI_Bcast(d.data(), int(3 * n), MPI_DOUBLE, 0, comm);
+        std::vector<double> shift;
+        inner.linear_response(d, shift);
         break;
       }
       case kEnd: {

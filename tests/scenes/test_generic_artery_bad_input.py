@@ -5,6 +5,7 @@ procedure: viscous tau <= 0, beta < 0, apposition threshold < 0, a layer without
 an unknown key in the viscous branch, too many lumen stations, a stress-average radius of 0, an
 axial refinement window outside the tube, a radial progression of 0; a solid Newton atol of the order of
 the peak pressure load and a coupling rel_tol of 1 (tolerances that pass a step before it moves);
+the interface Newton-Krylov without robin planes, and its section without it;
 pressures far outside any clinical range (units mistaken); PETSc options naming a preconditioner or
 factorization package that does not exist.
 No run directory is created (the launcher asks the executables with --check first).
@@ -63,6 +64,19 @@ CASES = [
         "surface compliance without robin planes",
         lambda s: s["coupling"].update(scheme="dirichlet-neumann", surface_compliance=True),
         "coupling.surface_compliance",
+    ),
+    (
+        "newton-krylov without robin planes",
+        lambda s: (
+            s["coupling"].pop("iqn"),
+            s["coupling"].update(scheme="dirichlet-neumann", surface_compliance=False, acceleration="newton-krylov"),
+        ),
+        "coupling.acceleration",
+    ),
+    (
+        "newton_krylov section with another acceleration",
+        lambda s: s["coupling"].update(newton_krylov={"max_products": 5}),
+        "coupling.newton_krylov",
     ),
     # absurd values inside the type's range: a pressure in Pa or kPa taken for MPa
     ("balloon pressure 1e6 MPa", lambda s: s["balloon"]["pressure"].update(value=1.0e6), "balloon.pressure"),

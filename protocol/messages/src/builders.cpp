@@ -95,6 +95,36 @@ Buffer solid_solve_reply(const Header& h, const participant::SolveStats& s, doub
   return finish(b, h, fb::Payload::SolidSolveReply, p.Union());
 }
 
+Buffer beam_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
+                           const std::vector<double>& plane_shift) {
+  FlatBufferBuilder b(64 + 8 * plane_shift.size());
+  auto p = fb::CreateBeamLinearRequest(b, step, iteration, b.CreateVector(plane_shift));
+  return finish(b, h, fb::Payload::BeamLinearRequest, p.Union());
+}
+
+Buffer beam_linear_reply(const Header& h, const participant::SolveStats& s, double wall,
+                         const std::vector<participant::Vec3>& dx) {
+  FlatBufferBuilder b(256 + 24 * dx.size());
+  auto st = stats(b, s, wall);
+  auto p = fb::CreateBeamLinearReply(b, st, vec3s(b, dx));
+  return finish(b, h, fb::Payload::BeamLinearReply, p.Union());
+}
+
+Buffer solid_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
+                            const std::vector<participant::Vec3>& dx) {
+  FlatBufferBuilder b(64 + 24 * dx.size());
+  auto p = fb::CreateSolidLinearRequest(b, step, iteration, vec3s(b, dx));
+  return finish(b, h, fb::Payload::SolidLinearRequest, p.Union());
+}
+
+Buffer solid_linear_reply(const Header& h, const participant::SolveStats& s, double wall,
+                          const std::vector<double>& plane_shift) {
+  FlatBufferBuilder b(256 + 8 * plane_shift.size());
+  auto st = stats(b, s, wall);
+  auto p = fb::CreateSolidLinearReply(b, st, b.CreateVector(plane_shift));
+  return finish(b, h, fb::Payload::SolidLinearReply, p.Union());
+}
+
 Buffer step_end(const Header& h, std::uint32_t step, bool accept) {
   FlatBufferBuilder b;
   auto p = fb::CreateStepEnd(b, step, accept);

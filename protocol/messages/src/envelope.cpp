@@ -29,6 +29,9 @@ const char* request_verb(fb::Payload p) {
     case fb::Payload::BeamSolveRequest:
     case fb::Payload::SolidSolveRequest:
       return "solve";
+    case fb::Payload::BeamLinearRequest:
+    case fb::Payload::SolidLinearRequest:
+      return "linearize";
     case fb::Payload::StepEnd:
       return "step_end";
     case fb::Payload::Shutdown:

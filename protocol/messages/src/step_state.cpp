@@ -40,6 +40,12 @@ void StepState::check(const fb::Envelope& env) {
     case fb::Payload::BeamSolveRequest:
       in_this_step(env.payload_as_BeamSolveRequest()->step());
       return;
+    case fb::Payload::BeamLinearRequest:
+      in_this_step(env.payload_as_BeamLinearRequest()->step());
+      return;
+    case fb::Payload::SolidLinearRequest:
+      in_this_step(env.payload_as_SolidLinearRequest()->step());
+      return;
     case fb::Payload::SolidSolveRequest: {
       const auto& r = *env.payload_as_SolidSolveRequest();
       in_this_step(r.step());

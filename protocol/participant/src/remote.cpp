@@ -126,6 +126,18 @@ SolveStats RemoteBeam::solve_(const std::vector<Vec3>& q, const ContactPlanes* p
   return msg::to_stats(r.stats());
 }
 
+SolveStats RemoteBeam::linear_response(const std::vector<double>& plane_shift, std::vector<Vec3>& dx) {
+  auto b = ch_.call([&](const msg::Header& h) { return msg::beam_linear_request(h, step_, iteration_, plane_shift); });
+  const auto& r = reply_as<fb::BeamLinearReply>(b);
+  account(ch_, r.stats());
+  dx = msg::to_vec3s(r.dx());
+  SolveStats s = msg::to_stats(r.stats());
+  if (s.converged && dx.size() != points_.size())
+    throw ParticipantError("beam participant returned " + std::to_string(dx.size()) + " displacements for " +
+                           std::to_string(points_.size()) + " sample points");
+  return s;
+}
+
 void RemoteBeam::end_step(bool accept) {
   ch_.call([&](const msg::Header& h) { return msg::step_end(h, step_, accept); });
 }
@@ -157,6 +169,14 @@ SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply, doub
   if (!pts.x.empty() && reply.line_loads.size() != pts.size())
     throw ParticipantError("solid participant returned " + std::to_string(reply.line_loads.size()) +
                            " line loads for " + std::to_string(pts.size()) + " sample points");
+  return msg::to_stats(r.stats());
+}
+
+SolveStats RemoteSolid::linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift) {
+  auto b = ch_.call([&](const msg::Header& h) { return msg::solid_linear_request(h, step_, iteration_, dx); });
+  const auto& r = reply_as<fb::SolidLinearReply>(b);
+  account(ch_, r.stats());
+  plane_shift = msg::to_doubles(r.plane_shift());
   return msg::to_stats(r.stats());
 }
 

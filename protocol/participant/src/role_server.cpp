@@ -159,6 +159,13 @@ int serve(BeamParticipant& beam, const ServeOptions& o) {
         SolveStats stats = robin ? beam.solve_with_planes(q, planes) : beam.solve(q);
         return msg::beam_solve_reply(h, stats, seconds_since(t0), beam.sample_points());
       }
+      case fb::Payload::BeamLinearRequest: {
+        const auto shift = msg::to_doubles(env.payload_as_BeamLinearRequest()->plane_shift());
+        std::vector<Vec3> dx;
+        const auto t0 = Clock::now();
+        SolveStats stats = beam.linear_response(shift, dx);
+        return msg::beam_linear_reply(h, stats, seconds_since(t0), dx);
+      }
       case fb::Payload::StepEnd:
         beam.end_step(env.payload_as_StepEnd()->accept());
         return msg::ack(h);
@@ -185,6 +192,13 @@ int serve(SolidParticipant& solid, const ServeOptions& o) {
         const auto t0 = Clock::now();
         SolveStats stats = solid.solve(pts, reply, r.tolerance());  // checked by msg::StepState
         return msg::solid_solve_reply(h, stats, seconds_since(t0), reply);
+      }
+      case fb::Payload::SolidLinearRequest: {
+        const auto dx = msg::to_vec3s(env.payload_as_SolidLinearRequest()->dx());
+        std::vector<double> shift;
+        const auto t0 = Clock::now();
+        SolveStats stats = solid.linear_response(dx, shift);
+        return msg::solid_linear_reply(h, stats, seconds_since(t0), shift);
       }
       case fb::Payload::StepEnd:
         solid.end_step(env.payload_as_StepEnd()->accept());

@@ -155,6 +155,13 @@ class BeamModel {
     double g0 = 0.0;  // mm, regularization of the law (plane_penalty.hpp)
   };
   void set_sample_planes(std::vector<SamplePlane> planes);
+  const std::vector<SamplePlane>& sample_planes() const { return planes_; }
+  // Linearized response at the current state (the interface Newton–Krylov, docs/design.md §5.5):
+  // the sample points' displacement (mm per unit of `shift`) when plane i moves by shift[i] along its
+  // normal, K du = −∂r/∂shift with the tangent here (the planes' penalty included). The state is left
+  // as it was. Throws std::invalid_argument if shift is not one value per plane, std::runtime_error
+  // if the tangent cannot be factorized.
+  std::vector<Vec3> plane_response(const std::vector<double>& shift);
   // Sample line loads plus the planes' penalty loads at the current configuration (N/mm).
   std::vector<Vec3> sample_contact_loads() const;
   const std::vector<Vec3>& sample_line_loads() const { return q_ext_; }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -29,6 +30,12 @@ class Acceleration {
   // response (IQN: the least-squares step moved planes without force by as much; Aitken: its
   // factor). Constant relaxation, without differences, ignores it.
   void mark_discontinuous(std::vector<Eigen::Index> components) { discontinuous_ = std::move(components); }
+  // Accelerations that take the map's Jacobian (newton-krylov) get J v, the derivative of the map
+  // q -> q~ along v at the last iterate, from the interface scheme and the participants. J v returns an
+  // empty vector when it cannot be had.
+  using JacobianProduct = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
+  virtual bool uses_jacobian() const { return false; }
+  void set_jacobian(JacobianProduct jv) { jacobian_ = std::move(jv); }
   // Called when a step converged (e.g. to carry the last relaxation factor to the next step).
   virtual void end_step(bool accepted) = 0;
   // Relaxation factor used in the last update (for logging; 1 for schemes without one).
@@ -39,6 +46,7 @@ class Acceleration {
   // The components marked since the last update, handed over once: every update() takes them first
   // (a mark applies to the one difference that update forms, none later).
   std::vector<Eigen::Index> take_discontinuous() { return std::exchange(discontinuous_, {}); }
+  JacobianProduct jacobian_;
   // Zeroes those rows of a difference.
   static void drop_rows(Eigen::VectorXd& difference, const std::vector<Eigen::Index>& rows) {
     for (Eigen::Index i : rows)

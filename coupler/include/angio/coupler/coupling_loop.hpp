@@ -28,6 +28,8 @@ struct StepReport {
   double beam_time = 0.0;         // s in beam solves (incl. messaging when remote)
   double solid_time = 0.0;        // s in solid solves (incl. messaging when remote)
   double wall_time = 0.0;         // s for the whole step incl. rejected attempts
+  int products = 0;               // newton-krylov: Jacobian-vector products of the accepted attempt
+  double product_time = 0.0;      // s in them (both participants' linearized responses and messaging)
   participant::ContactReply contact;
   participant::SamplePoints beam_points;
 };

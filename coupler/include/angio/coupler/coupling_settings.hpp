@@ -7,6 +7,7 @@
 
 #include "angio/coupler/acceleration.hpp"
 #include "angio/coupler/iqn_ils.hpp"
+#include "angio/coupler/newton_krylov.hpp"
 #include "angio/scene/node.hpp"
 
 namespace angio::coupler {
@@ -18,6 +19,7 @@ struct CouplingSettings {
   double initial_relaxation = scene::keys::defaults::coupling_initial_relaxation;
   double max_relaxation = 1.0;  // max(1, initial_relaxation) when not given
   IqnIlsOptions iqn;
+  NewtonKrylovOptions newton_krylov;
   int max_iterations = scene::keys::defaults::coupling_max_iterations;
   double rel_tol = scene::keys::defaults::coupling_rel_tol;
   double abs_tol = scene::keys::defaults::coupling_abs_tol;

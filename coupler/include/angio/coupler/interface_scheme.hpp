@@ -16,6 +16,7 @@
 
 #include "angio/coupler/acceleration.hpp"
 #include "angio/participant/beam_participant.hpp"
+#include "angio/participant/solid_participant.hpp"
 
 namespace angio::coupler {
 
@@ -33,6 +34,15 @@ class InterfaceScheme {
                                          const participant::ContactReply& reply) = 0;
   // Next iterate through the acceleration (iteration k of the step, 0-based).
   virtual void next_iterate(Acceleration& acc, int k) = 0;
+  // The derivative of the map (iterate -> the solid's reply as an iterate) along v at the last
+  // iterate, from the participants' linearized responses at their last solves (newton-krylov; call
+  // between force_residual() and next_iterate()). Empty when a participant cannot linearize or the
+  // scheme has no such derivative.
+  virtual Eigen::VectorXd map_derivative(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
+                                         const Eigen::VectorXd& v) {
+    (void)beam, (void)solid, (void)v;
+    return {};
+  }
   // The step was accepted with the last force_residual(): remember the converged state.
   virtual void accept(double increment) = 0;
   // The step was rejected and will be cut (its attempt is tried again from the accepted state).

@@ -39,6 +39,8 @@ class Robin : public InterfaceScheme {
   participant::SolveStats solve_beam(participant::BeamParticipant& beam) override;
   Eigen::VectorXd force_residual(const participant::SamplePoints& x, const participant::ContactReply& reply) override;
   void next_iterate(Acceleration& acc, int k) override;
+  Eigen::VectorXd map_derivative(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
+                                 const Eigen::VectorXd& v) override;
   void accept(double increment) override;
   void reject() override;
 

@@ -296,6 +296,12 @@ class SolidModel {
   // contribution) at this rank's owned nodes: entry i for node owned_node_begin() + i (new numbering).
   // Collective.
   std::vector<Vec3d> contact_forces(ContactModel& c);
+  // The displacement du (the held nodes, state() order) with K du = f for nodal forces f on the owned nodes
+  // (contact_forces() order), prescribed components held: the linear solver as the last solve left it
+  // (modified Newton: its last factorization, of the tangent at an earlier iterate). For the
+  // interface Newton–Krylov's solid response (docs/design.md §5.5); the state does not change.
+  // Collective. Returns an empty message, or why the solve failed.
+  std::string tangent_response(const std::vector<Vec3d>& f, std::vector<double>& du);
   // Assemble residual (and tangent) at the current state; for tests. Returns false on invalid state.
   bool assemble(Vec r, Mat K);
   // The element an assemble() last found invalid (non-positive Jacobian or NaN), its block and the

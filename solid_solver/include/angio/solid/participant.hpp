@@ -28,6 +28,9 @@ class StentContact : public ContactModel {
   // The contact of the current state for the reply to the beam, complete on rank 0 (the rank that
   // answers the coupler); the other ranks' reply is left as given. Collective.
   virtual void fill_reply(const SolidModel& model, participant::ContactReply& reply) = 0;
+  // The stent line contact alone (its points, forces and reply), without contact models that do not
+  // depend on the points (a composite's others); nullptr if there is none.
+  virtual StentContact* line_part() { return this; }
   // Gap of every sample point of set_points() to the surface set `surface` at the current state
   // (mm, g = (x − s)·n − R; +∞ where no face lies within the search radius), and the points'
   // arc-length weights; both empty if this contact does not involve that surface, and on every rank
@@ -89,6 +92,9 @@ class SolidRunner : public participant::SolidParticipant {
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const participant::SamplePoints& beam_points, participant::ContactReply& reply,
                                 double tolerance) override;
+  // Collective; the shifts on rank 0 (the other ranks' left empty).
+  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx,
+                                          std::vector<double>& plane_shift) override;
   void end_step(bool accept) override;
   void finish() override;
 
@@ -149,6 +155,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<int> lumen_nodes_;          // the lumen profile's nodes (held on every rank)
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
   std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
+  participant::SamplePoints points_;        // and with their weights and radii (linear_response)
   // The last converged solve of the step (pseudo-time and sample points) and of the last committed
   // step: where a continuation starts from.
   double ok_time_ = 0.0, committed_ok_time_ = 0.0;
@@ -172,6 +179,8 @@ class MpiSolidParticipant : public participant::SolidParticipant {
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const participant::SamplePoints& beam_points, participant::ContactReply& reply,
                                 double tolerance) override;
+  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx,
+                                          std::vector<double>& plane_shift) override;
   void end_step(bool accept) override;
   void finish() override;
   // Releases the followers if finish() was never called (e.g. the coupler vanished).

@@ -204,6 +204,7 @@ class CompositeContact : public StentContact {
   void fill_reply(const SolidModel& model, participant::ContactReply& reply) override;
   void gaps(const SolidModel& model, const std::string& surface, std::vector<double>& gap,
             std::vector<double>& weight) override;
+  StentContact* line_part() override { return stent_; }
   // Called on every rank after each converged solve's reply (e.g. logging of the contact diagnostics).
   std::function<void(const SolidModel&, const participant::ContactReply&)> after_reply;
 

@@ -28,6 +28,17 @@ Buffer solid_solve_request(const Header& h, std::uint32_t step, std::uint32_t it
                            const participant::SamplePoints& points, double tolerance);
 Buffer solid_solve_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
                          const participant::ContactReply& contact);
+// Linearized responses at the last solve (the interface Newton–Krylov): per plane a shift along its
+// normal (mm) to the beam, the sample points' displacement back; the points' displacement to the
+// solid, per plane its shift back.
+Buffer beam_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
+                           const std::vector<double>& plane_shift);
+Buffer beam_linear_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
+                         const std::vector<participant::Vec3>& dx);
+Buffer solid_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
+                            const std::vector<participant::Vec3>& dx);
+Buffer solid_linear_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
+                          const std::vector<double>& plane_shift);
 Buffer step_end(const Header& h, std::uint32_t step, bool accept);
 Buffer ack(const Header& h);
 Buffer shutdown(const Header& h, const std::string& reason);

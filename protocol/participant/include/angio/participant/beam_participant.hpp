@@ -27,6 +27,17 @@ class BeamParticipant {
     s.message = "this beam participant does not support the robin coupling mode (contact planes)";
     return s;
   }
+  // Interface Newton–Krylov (docs/design.md §5.5): the sample points' displacement dx (3 per point)
+  // when plane j of the last solve_with_planes() moves by plane_shift[j] along its normal (mm),
+  // linearized at the state that solve left: the beam's tangent with the planes' penalty. Nothing is
+  // solved anew or kept. Participants that cannot do this keep this default (a failed stats saying so).
+  virtual SolveStats linear_response(const std::vector<double>& plane_shift, std::vector<Vec3>& dx) {
+    (void)plane_shift;
+    dx.clear();
+    SolveStats s;
+    s.message = "this beam participant has no linearized response (coupling.acceleration newton-krylov)";
+    return s;
+  }
   // accept: commit the plastic state and write output; reject: restore the last committed state.
   virtual void end_step(bool accept) = 0;
   // Close output files and write the summary.

@@ -83,6 +83,7 @@ class RemoteBeam : public BeamParticipant {
   void begin_step(int step, double time) override;
   SolveStats solve(const std::vector<Vec3>& line_loads) override;
   SolveStats solve_with_planes(const std::vector<Vec3>& line_loads, const ContactPlanes& planes) override;
+  SolveStats linear_response(const std::vector<double>& plane_shift, std::vector<Vec3>& dx) override;
   void end_step(bool accept) override;
   void finish() override;  // sends Shutdown
   void set_iteration(int k) { iteration_ = k; }
@@ -102,6 +103,7 @@ class RemoteSolid : public SolidParticipant {
   std::string hello();
   void begin_step(int step, double time) override;
   SolveStats solve(const SamplePoints& beam_points, ContactReply& reply, double tolerance) override;
+  SolveStats linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift) override;
   void end_step(bool accept) override;
   void finish() override;
   void set_iteration(int k) { iteration_ = k; }

@@ -16,6 +16,17 @@ class SolidParticipant {
   // Empty `beam_points` means no stent. tolerance > 0: the absolute residual (N) the coupler allows
   // for this solve (inexact solves inside the coupling loop); 0: the participant's own tolerance.
   virtual SolveStats solve(const SamplePoints& beam_points, ContactReply& reply, double tolerance) = 0;
+  // Interface Newton–Krylov (docs/design.md §5.5): how far each contact plane of the last solve's
+  // reply moves along its normal (plane_shift, as that reply's planes) when the sample points move by
+  // dx, linearized at the state that solve left (the solid's tangent as last factorized). Nothing is
+  // solved anew or kept. Default: a failed stats saying it is not supported.
+  virtual SolveStats linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift) {
+    (void)dx;
+    plane_shift.clear();
+    SolveStats s;
+    s.message = "this solid participant has no linearized response (coupling.acceleration newton-krylov)";
+    return s;
+  }
   // accept: commit history and write output; reject: roll back to the last committed state.
   virtual void end_step(bool accept) = 0;
   virtual void finish() = 0;
