@@ -14,7 +14,7 @@ class EigenBackend : public LinearSolver {
  public:
   explicit EigenBackend(const char* n) : name_(n) {}
   const char* name() const override { return name_; }
-  Eigen::VectorXd solve(const SpMat& K, const Eigen::VectorXd& b) override {
+  void factorize(const SpMat& K) override {
     if (K.rows() != rows_ || K.nonZeros() != nnz_) {
       solver_.analyzePattern(K);
       rows_ = K.rows();
@@ -25,6 +25,8 @@ class EigenBackend : public LinearSolver {
       throw std::runtime_error(std::string(name_) +
                                ": factorization failed (singular stiffness matrix? "
                                "check supports: rigid-body modes must be removed)");
+  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) override {
     Eigen::VectorXd x = solver_.solve(b);
     if (solver_.info() != Eigen::Success) throw std::runtime_error(std::string(name_) + ": solve failed");
     return x;

@@ -419,32 +419,51 @@ void BeamModel::apply_increment(const Eigen::VectorXd& d, double alpha) {
   }
 }
 
-std::vector<Vec3> BeamModel::plane_response(const std::vector<double>& shift) {
-  if (shift.size() != planes_.size())
-    throw std::invalid_argument("expected one shift per contact plane (" + std::to_string(planes_.size()) + "), got " +
-                                std::to_string(shift.size()));
+bool BeamModel::ResponseTangent::matches(const BeamModel& m) const {
+  if (!lin || time != m.time_ || x != m.x_ || q != m.q_ext_ || planes.size() != m.planes_.size()) return false;
+  for (std::size_t i = 0; i < R.size(); ++i)
+    if (R[i].coeffs() != m.R_[i].coeffs()) return false;
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    const SamplePlane &a = planes[i], &b = m.planes_[i];
+    if (a.s != b.s || a.n != b.n || a.eps != b.eps || a.g0 != b.g0) return false;
+  }
+  return true;
+}
+
+std::vector<Vec3> BeamModel::plane_response(const std::vector<double>& shift, const std::vector<Vec3>& turn) {
+  if (shift.size() != planes_.size() || (!turn.empty() && turn.size() != planes_.size()))
+    throw std::invalid_argument("expected one shift (and none or one turn) per contact plane (" +
+                                std::to_string(planes_.size()) + "), got " + std::to_string(shift.size()) + " and " +
+                                std::to_string(turn.size()));
   std::vector<Vec3> dx(num_sample_points(), Vec3::Zero());
   double smax = 0.0;
   for (double v : shift) smax = std::max(smax, std::abs(v));
+  for (const Vec3& t : turn) smax = std::max(smax, t.cwiseAbs().maxCoeff());
   if (!(smax > 0.0)) return dx;
-  if (!lin_) lin_ = make_linear_solver(newton.linear_solver);
-  SpMat K;
-  Eigen::VectorXd r0, rp, rm;
-  assemble(&K, r0);
-  // ∂r/∂shift by central differences of the residual in the planes alone (the state does not move,
-  // so the elements' trial states stay those of the current state): exact for the linear penalty
-  // law and for the quadratic part of the regularized one; 1e-6 mm against positions of order 1 mm
-  // leaves round-off of about 1e-10 relative.
+  if (!response_.matches(*this)) {  // the products of one coupling iteration share one factorization
+    if (!response_.lin) response_.lin = make_linear_solver(newton.linear_solver);
+    assemble(&response_.K, response_.r);
+    response_.lin->factorize(response_.K);
+    response_.x = x_;
+    response_.R = R_;
+    response_.q = q_ext_;
+    response_.planes = planes_;
+    response_.time = time_;
+  }
+  // ∂r/∂(shift, turn) by forward differences of the residual in the planes alone (the state does not
+  // move, so the elements' trial states stay those of the current state): exact in the shift for the
+  // linear penalty law and for the quadratic part of the regularized one, O(h) in the turn; 1e-6
+  // against positions of order 1 mm leaves round-off of about 1e-10 relative.
   const double h = 1e-6 / smax;
   const std::vector<SamplePlane> planes = planes_;
-  auto residual_shifted = [&](double a, Eigen::VectorXd& r) {
-    for (std::size_t i = 0; i < planes.size(); ++i) planes_[i].s = planes[i].s + a * h * shift[i] * planes[i].n;
-    assemble(nullptr, r);
-  };
-  residual_shifted(1.0, rp);
-  residual_shifted(-1.0, rm);
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    planes_[i].s = planes[i].s + h * shift[i] * planes[i].n;
+    if (!turn.empty()) planes_[i].n = planes[i].n + h * turn[i];
+  }
+  Eigen::VectorXd rp;
+  assemble(nullptr, rp);
   planes_ = planes;
-  const Eigen::VectorXd du = lin_->solve(K, -(rp - rm) / (2.0 * h));
+  const Eigen::VectorXd du = response_.lin->solve(-(rp - response_.r) / h);
   // sample positions are linear in the nodes' positions: one whole increment gives them exactly
   const std::vector<Vec3> xs = x_;
   const std::vector<Quat> Rs = R_;

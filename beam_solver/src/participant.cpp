@@ -114,18 +114,22 @@ participant::SolveStats BeamSolverParticipant::solve_with_planes(const std::vect
 }
 
 participant::SolveStats BeamSolverParticipant::linear_response(const std::vector<double>& shift,
+                                                               const std::vector<participant::Vec3>& turn,
                                                                std::vector<participant::Vec3>& dx) {
   BeamModel& m = *scene_.model;
   participant::SolveStats out;
   dx.clear();
-  if (m.sample_planes().empty() || shift.size() != m.sample_planes().size()) {
+  if (m.sample_planes().empty() || shift.size() != m.sample_planes().size() ||
+      (!turn.empty() && turn.size() != shift.size())) {
     out.message =
         "a linearized response needs the planes of a solve before it: " + std::to_string(m.sample_planes().size()) +
-        " planes, " + std::to_string(shift.size()) + " shifts";
+        " planes, " + std::to_string(shift.size()) + " shifts, " + std::to_string(turn.size()) + " turns";
     return out;
   }
+  std::vector<Vec3> t(turn.size());
+  for (std::size_t i = 0; i < turn.size(); ++i) t[i] = Vec3(turn[i][0], turn[i][1], turn[i][2]);
   try {
-    for (const Vec3& d : m.plane_response(shift)) dx.push_back({d.x(), d.y(), d.z()});
+    for (const Vec3& d : m.plane_response(shift, t)) dx.push_back({d.x(), d.y(), d.z()});
   } catch (const std::exception& e) {
     out.message = std::string("beam linearized response at step ") + std::to_string(step_) + ": " + e.what();
     return out;

@@ -169,6 +169,8 @@ RunReport run_coupled(participant::BeamParticipant& beam, participant::SolidPart
 
     run.beam_time += rep.beam_time;  // every attempt: a rejected one cost its solves too
     run.solid_time += rep.solid_time;
+    run.products += rep.products;
+    run.product_time += rep.product_time;
     const bool accept = converged || (!participant_failed && !settings.strict && rep.iterations > 0);
     if (!accept && failed_at == 0 && extrapolate) {
       LOG_INFO("step " << rep.step << " t = " << rep.time << " s: " << failure

@@ -215,11 +215,39 @@ void Robin::next_iterate(Acceleration& acc, int k) {
                                   << switched << " switched since the last reply");
     }
   }
-  acc.mark_discontinuous(std::move(jumped));
-  Eigen::VectorXd next = acc.update(p_.s, r, k);
-  LOG_DEBUG("robin: plane residual " << r.norm() << ", update " << (next - p_.s).norm());
-  p_.s = std::move(next);
-  p_.n = p_tilde_.n;
+  if (!acc.uses_jacobian()) {
+    acc.mark_discontinuous(std::move(jumped));
+    Eigen::VectorXd next = acc.update(p_.s, r, k);
+    LOG_DEBUG("robin: plane residual " << r.norm() << ", update " << (next - p_.s).norm());
+    p_.s = std::move(next);
+    p_.n = p_tilde_.n;
+  } else {
+    // Newton: the normals are unknowns too. The solid turns them as the surface deforms, and the beam
+    // answers a turn (the force's direction) with its soft sliding modes; taken from the last reply
+    // as they are, they converge by plain substitution, which the Newton step on the points alone
+    // cannot speed up (measured on the straight free expansion's lock-up: the planes' change after a
+    // step was twice what their own linearization predicted, all of it from the normals' turn).
+    const Eigen::Index m3 = p_.s.size();
+    Eigen::VectorXd q(2 * m3), rq = Eigen::VectorXd::Zero(2 * m3);
+    q << p_.s, p_.n;
+    rq.head(m3) = r;
+    for (Eigen::Index i = 0; i < p_.eps.size(); ++i)
+      if (p_tilde_.eps[i] > 0.0 && p_.eps[i] > 0.0)
+        rq.segment<3>(m3 + 3 * i) = p_tilde_.n.segment<3>(3 * i) - p_.n.segment<3>(3 * i);
+    const std::size_t jumped_s = jumped.size();
+    for (std::size_t c = 0; c < jumped_s; ++c) jumped.push_back(m3 + jumped[c]);
+    acc.mark_discontinuous(std::move(jumped));
+    const Eigen::VectorXd next = acc.update(q, rq, k);
+    LOG_DEBUG("robin: plane residual " << r.norm() << ", normals' residual " << rq.tail(m3).norm() << ", update "
+                                       << (next - q).norm());
+    p_.s = next.head(m3);
+    for (Eigen::Index i = 0; i < p_.eps.size(); ++i) {
+      const Eigen::Vector3d n = next.segment<3>(m3 + 3 * i);
+      p_.n.segment<3>(3 * i) = p_tilde_.eps[i] > 0.0 && p_.eps[i] > 0.0 && n.norm() > 0.5
+                                   ? Eigen::Vector3d(n.normalized())
+                                   : Eigen::Vector3d(p_tilde_.n.segment<3>(3 * i));
+    }
+  }
   p_.eps = p_tilde_.eps;
   p_.g0 = p_tilde_.g0;
   c_ = c_tilde_;
@@ -227,34 +255,53 @@ void Robin::next_iterate(Acceleration& acc, int k) {
 
 Eigen::VectorXd Robin::map_derivative(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
                                       const Eigen::VectorXd& v) {
-  // v moves the planes the beam solved with (p_); only their normal part moves a plane
-  const Eigen::Index m = p_.eps.size();
+  // v moves the planes the beam solved with (p_): the points' part only along the normals, and with
+  // the normals as unknowns (next_iterate) their part perpendicular to them
+  const Eigen::Index m = p_.eps.size(), m3 = p_.s.size();
+  const bool normals = v.size() == 2 * m3;
   std::vector<double> shift(std::size_t(m), 0.0);
-  for (Eigen::Index j = 0; j < m; ++j)
-    if (p_.eps[j] > 0.0) shift[std::size_t(j)] = p_.n.segment<3>(3 * j).dot(v.segment<3>(3 * j));
+  std::vector<participant::Vec3> turn(normals ? std::size_t(m) : 0, {0.0, 0.0, 0.0});
+  for (Eigen::Index j = 0; j < m; ++j) {
+    if (!(p_.eps[j] > 0.0)) continue;
+    const Eigen::Vector3d n = p_.n.segment<3>(3 * j);
+    shift[std::size_t(j)] = n.dot(v.segment<3>(3 * j));
+    if (!normals) continue;
+    const Eigen::Vector3d t = v.segment<3>(m3 + 3 * j) - n.dot(v.segment<3>(m3 + 3 * j)) * n;
+    turn[std::size_t(j)] = {t.x(), t.y(), t.z()};
+  }
   std::vector<participant::Vec3> dx;
-  if (!beam.linear_response(shift, dx).converged || dx.size() != n_) return {};
+  if (!beam.linear_response(shift, turn, dx).converged || dx.size() != n_) return {};
   std::vector<double> ds;
-  if (!solid.linear_response(dx, ds).converged || ds.size() != std::size_t(m)) return {};
-  // The solid's planes (reply_) move by ds along their normals and the points by dx; the iterate
-  // made of them (softened with surface compliance: a function of both) by forward differences,
-  // exact where the penalty law is linear.
+  std::vector<participant::Vec3> dn;
+  if (!solid.linear_response(dx, ds, dn).converged || ds.size() != std::size_t(m) || dn.size() != std::size_t(m))
+    return {};
+  // The solid's planes (reply_) move by ds along their normals and turn by dn, the points move by dx;
+  // the iterate made of them (softened with surface compliance: a function of all three) by forward
+  // differences, exact in the points and the shifts where the penalty law is linear.
   double amax = 0.0;
   for (const auto& d : dx) amax = std::max({amax, std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
+  for (const auto& d : dn) amax = std::max({amax, std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
   for (double d : ds) amax = std::max(amax, std::abs(d));
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(p_.s.size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(v.size());
   if (!(amax > 0.0)) return out;
   const double h = 1e-6 / amax;
   participant::SamplePoints x1 = x_;
   for (std::size_t i = 0; i < n_; ++i)
     for (int c = 0; c < 3; ++c) x1.x[i][c] += h * dx[i][c];
   Planes r1 = reply_;
-  for (Eigen::Index j = 0; j < m; ++j) r1.s.segment<3>(3 * j) += h * ds[std::size_t(j)] * reply_.n.segment<3>(3 * j);
+  for (Eigen::Index j = 0; j < m; ++j) {
+    if (!(reply_.eps[j] > 0.0)) continue;
+    const Eigen::Vector3d n = reply_.n.segment<3>(3 * j);
+    const std::size_t js = std::size_t(j);
+    r1.s.segment<3>(3 * j) += h * ds[js] * n;
+    r1.n.segment<3>(3 * j) = (n + h * Eigen::Vector3d(dn[js][0], dn[js][1], dn[js][2])).normalized();
+  }
   const Planes t1 = compliance_ ? softened_(x1, r1, plane_forces(x1, r1)) : r1;
   for (Eigen::Index j = 0; j < m; ++j) {
     if (!(p_tilde_.eps[j] > 0.0)) continue;
     const Eigen::Vector3d n = p_tilde_.n.segment<3>(3 * j);
     out.segment<3>(3 * j) = n.dot(t1.s.segment<3>(3 * j) - p_tilde_.s.segment<3>(3 * j)) / h * n;
+    if (normals) out.segment<3>(m3 + 3 * j) = (t1.n.segment<3>(3 * j) - n) / h;
   }
   return out;
 }

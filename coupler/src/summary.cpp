@@ -25,6 +25,8 @@ std::string coupling_summary_json(const std::string& status, const std::string& 
   j["solid_time"] = finite(run.solid_time);
   j["messaging_time"] = finite(messaging_time);
   j["messaging_share"] = finite(run.wall_time > 0 ? messaging_time / run.wall_time : 0.0);
+  j["jacobian_products"] = run.products;  // newton-krylov: products of every attempt
+  j["product_time"] = finite(run.product_time);
   // an exception text with invalid UTF-8 is replaced character-wise, not an exception here
   return j.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n";
 }

@@ -1156,11 +1156,18 @@ std::string SolidModel::tangent_response(const std::vector<Vec3d>& f, std::vecto
   ANGIO_PETSC(VecRestoreArray(r_, &a));
   ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
   if (!kept_splits_.empty()) keep_splits_(true);
+  // An iterative solver stops at 1e-3 of the forces here: the Newton–Krylov wants its products to a
+  // few per cent (its GMRES tolerance is 0.1 by default), not to the Newton's own linear tolerance.
+  PetscReal rtol, abstol, dtol;
+  PetscInt maxits;
+  ANGIO_PETSC(KSPGetTolerances(ksp_, &rtol, &abstol, &dtol, &maxits));
+  ANGIO_PETSC(KSPSetTolerances(ksp_, std::max(rtol, PetscReal(1e-3)), abstol, dtol, maxits));
   KSPConvergedReason reason;
   {
     OptionsScope scope(options_);
     ANGIO_PETSC(KSPSolve(ksp_, r_, du_));
   }
+  ANGIO_PETSC(KSPSetTolerances(ksp_, rtol, abstol, dtol, maxits));
   ANGIO_PETSC(KSPGetConvergedReason(ksp_, &reason));
   if (reason < 0 && reason != KSP_DIVERGED_ITS) return std::string("linear solver: ") + KSPConvergedReasons[reason];
   gather_(du_, du);

@@ -165,6 +165,7 @@ void SolidRunner::begin_step(int step, double time) {
   time_ = time;
   model_->set_time(time);
   predicted_ = model_->predict();
+  linearizable_ = false;  // no solve of this step yet
 }
 
 participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply,
@@ -196,6 +197,11 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
     stent_contact_->fill_reply(*model_, reply);
     reply_seconds_ += MPI_Wtime() - t_reply;
   }
+  // the state a linearized response starts from (linear_response): this reply, and the contact
+  // forces here once a response asks for them
+  linearizable_ = last_.converged;
+  linear_forces_.clear();
+  if (linearizable_) linear_reply_ = reply;
   participant::SolveStats s;
   s.converged = last_.converged;
   s.iterations = last_.iterations;
@@ -212,50 +218,47 @@ participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts,
 }
 
 participant::SolveStats SolidRunner::linear_response(const std::vector<participant::Vec3>& dx,
-                                                     std::vector<double>& plane_shift) {
+                                                     std::vector<double>& plane_shift,
+                                                     std::vector<participant::Vec3>& normal_turn) {
   participant::SolveStats out;
   plane_shift.clear();
+  normal_turn.clear();
   StentContact* line = stent_contact_ ? stent_contact_->line_part() : nullptr;
-  if (!line || dx.size() != points_.size() || points_.x.empty() || !last_.converged) {
-    out.message = "a linearized response needs a converged solve with the stent's " + std::to_string(points_.size()) +
-                  " sample points before it (got " + std::to_string(dx.size()) + " displacements" +
-                  (line ? ")" : ", and this solid has no stent contact)");
+  if (!line || dx.size() != points_.size() || points_.x.empty() || !linearizable_) {
+    out.message = "a linearized response needs a converged solve of this step with the stent's " +
+                  std::to_string(points_.size()) + " sample points before it (got " + std::to_string(dx.size()) +
+                  " displacements" + (line ? ")" : ", and this solid has no stent contact)");
     return out;
   }
   double dmax = 0.0;
   for (const auto& d : dx) dmax = std::max({dmax, std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
-  // Central differences of the contact forces in the points, and forward ones of the planes in the
-  // points and the displacement together: exact for the linear penalty law away from its switches;
-  // 1e-6 mm against positions of order 1 mm leaves round-off of about 1e-10 relative.
+  // Forward differences of the contact forces in the points and of the planes in the points and the
+  // displacement together, from the solve's own reply and the forces there (computed once for all
+  // products at this state): exact for the linear penalty law away from its switches, O(h) in the
+  // surface's curvature; 1e-6 mm against positions of order 1 mm leaves round-off of about 1e-10
+  // relative.
   const double h = dmax > 0.0 ? 1e-6 / dmax : 0.0;
-  auto moved = [&](double a) {
-    participant::SamplePoints p = points_;
-    for (std::size_t i = 0; i < p.x.size(); ++i)
-      for (int c = 0; c < 3; ++c) p.x[i][c] += a * h * dx[i][c];
-    return p;
-  };
-  participant::ContactReply base, shifted;
-  reset_reply(points_, base);
-  line->fill_reply(*model_, base);  // the solve's last evaluation when it saw this configuration
-  const std::vector<double> u0 = model_->state();
   std::string failed;
+  participant::ContactReply shifted;
   if (h > 0.0) {
-    line->set_points(moved(1.0));
+    if (linear_forces_.empty()) linear_forces_ = model_->contact_forces(*line);
+    participant::SamplePoints moved = points_;
+    for (std::size_t i = 0; i < moved.x.size(); ++i)
+      for (int c = 0; c < 3; ++c) moved.x[i][c] += h * dx[i][c];
+    line->set_points(moved);
     std::vector<Vec3d> f = model_->contact_forces(*line);
-    line->set_points(moved(-1.0));
-    const std::vector<Vec3d> fm = model_->contact_forces(*line);
-    for (std::size_t i = 0; i < f.size(); ++i) f[i] = (f[i] - fm[i]) / (2.0 * h);  // forces on the solid: K du = df
+    for (std::size_t i = 0; i < f.size(); ++i) f[i] = (f[i] - linear_forces_[i]) / h;  // on the solid: K du = df
     std::vector<double> du;
     failed = model_->tangent_response(f, du);
     if (failed.empty()) {
+      const std::vector<double> u0 = model_->state();
       std::vector<double> u1 = u0;
       for (std::size_t i = 0; i < u1.size(); ++i) u1[i] += h * du[i];
       model_->restore_state(u1);
-      line->set_points(moved(1.0));
-      reset_reply(points_, shifted);
+      reset_reply(moved, shifted);
       line->fill_reply(*model_, shifted);
+      model_->restore_state(u0);
     }
-    model_->restore_state(u0);
     line->set_points(points_);
   }
   if (!failed.empty()) {
@@ -264,7 +267,9 @@ participant::SolveStats SolidRunner::linear_response(const std::vector<participa
   }
   out.converged = true;
   if (rank_ != 0) return out;
+  const participant::ContactReply& base = linear_reply_;
   plane_shift.assign(base.penalty.size(), 0.0);
+  normal_turn.assign(base.penalty.size(), {0.0, 0.0, 0.0});
   if (h > 0.0)
     for (std::size_t j = 0; j < plane_shift.size(); ++j) {
       if (!(base.penalty[j] > 0.0) || !(shifted.penalty[j] > 0.0)) continue;  // a plane in range at both ends
@@ -272,6 +277,7 @@ participant::SolveStats SolidRunner::linear_response(const std::vector<participa
       double d = 0.0;
       for (int c = 0; c < 3; ++c) d += n[c] * (shifted.surface_points[j][c] - base.surface_points[j][c]);
       plane_shift[j] = d / h;
+      for (int c = 0; c < 3; ++c) normal_turn[j][c] = (shifted.normals[j][c] - n[c]) / h;
     }
   return out;
 }
@@ -329,6 +335,7 @@ SolveReport SolidRunner::continuation_(const participant::SamplePoints& pts, con
 }
 
 void SolidRunner::end_step(bool accept) {
+  linearizable_ = false;
   if (!accept) {
     model_->rollback();
     ok_time_ = committed_ok_time_;
@@ -780,14 +787,15 @@ participant::SolveStats MpiSolidParticipant::solve(const participant::SamplePoin
 }
 
 participant::SolveStats MpiSolidParticipant::linear_response(const std::vector<participant::Vec3>& dx,
-                                                             std::vector<double>& plane_shift) {
+                                                             std::vector<double>& plane_shift,
+                                                             std::vector<participant::Vec3>& normal_turn) {
   int cmd = kLinear;
   MPI_Bcast(&cmd, 1, MPI_INT, 0, comm_);
   std::vector<participant::Vec3> d = dx;
   long n = long(d.size());
   MPI_Bcast(&n, 1, MPI_LONG, 0, comm_);
   if (n > 0) MPI_Bcast(d.data(), int(3 * n), MPI_DOUBLE, 0, comm_);
-  return inner_.linear_response(d, plane_shift);
+  return inner_.linear_response(d, plane_shift, normal_turn);
 }
 
 void MpiSolidParticipant::end_step(bool accept) {
@@ -835,7 +843,8 @@ int run_follower(participant::SolidParticipant& inner, MPI_Comm comm) {
         std::vector<participant::Vec3> d(static_cast<std::size_t>(n));
         if (n > 0) MPI_Bcast(d.data(), int(3 * n), MPI_DOUBLE, 0, comm);
         std::vector<double> shift;
-        inner.linear_response(d, shift);
+        std::vector<participant::Vec3> turn;
+        inner.linear_response(d, shift, turn);
         break;
       }
       case kEnd: {

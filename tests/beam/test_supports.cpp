@@ -231,6 +231,15 @@ TEST(BeamSupports, TwoContactPlanesPerPointAddUpAndLinearize) {
   EXPECT_THROW(m.set_sample_planes(planes), std::invalid_argument);
 }
 
+// plane_response at the state (x, R) of converged planes `planes`, for the given shift and turn.
+std::vector<Vec3> m_response_with_turn(BeamModel& m, const std::vector<BeamModel::SamplePlane>& planes,
+                                       const std::vector<Vec3>& x, const std::vector<Quat>& R,
+                                       const std::vector<double>& shift, const std::vector<Vec3>& turn) {
+  m.set_sample_planes(planes);
+  m.set_state(x, R);
+  return m.plane_response(shift, turn);
+}
+
 // The interface Newton–Krylov's beam response (BeamModel::plane_response): the sample points'
 // displacement per unit shift of the planes along their normals, from the tangent at a converged
 // state, against central differences of converged Newton solves with the planes shifted by ±h
@@ -259,9 +268,13 @@ TEST(BeamSupports, PlaneResponseMatchesDifferencesOfSolves) {
   const std::vector<Vec3> x0 = m.positions();
   std::vector<Quat> R0;
   for (int i = 0; i < m.num_nodes(); ++i) R0.push_back(m.rotation(i));
-  auto solved_points = [&](double a) {
+  // the points solved with the planes shifted by a·shift and their normals turned by a·turn
+  auto solved_points = [&](double a, const std::vector<Vec3>& turn) {
     std::vector<BeamModel::SamplePlane> p = planes;
-    for (int g = 0; g < ng; ++g) p[g].s += a * shift[g] * nb;
+    for (int g = 0; g < ng; ++g) {
+      p[g].s += a * shift[g] * nb;
+      if (!turn.empty()) p[g].n = (nb + a * turn[g]).normalized();
+    }
     m.set_sample_planes(p);
     m.set_state(x0, R0);
     EXPECT_TRUE(m.solve().converged);
@@ -270,7 +283,7 @@ TEST(BeamSupports, PlaneResponseMatchesDifferencesOfSolves) {
     return x;
   };
   const double h = 1e-5;  // mm: truncation O(h²) against Newton's residual 1e-12 N / h
-  const std::vector<Vec3> xp = solved_points(h), xm = solved_points(-h);
+  const std::vector<Vec3> xp = solved_points(h, {}), xm = solved_points(-h, {});
   double err = 0.0, size = 0.0;
   for (int g = 0; g < ng; ++g) {
     const Vec3 fd = (xp[g] - xm[g]) / (2.0 * h);
@@ -280,4 +293,24 @@ TEST(BeamSupports, PlaneResponseMatchesDifferencesOfSolves) {
   std::printf("plane response %.3e, difference to the solves %.2e\n", size, err);
   ASSERT_GT(size, 0.1);  // the points follow their planes
   EXPECT_LT(err, 1e-6 * size);
+  // the planes' normals turned as well (across them): the forces' direction changes and the strut
+  // slides; forward differences in the beam (O(h) in the turn), so 1e-5 of the response
+  std::vector<Vec3> turn(ng);
+  for (int g = 0; g < ng; ++g) {
+    const Vec3 t(0.3 * std::cos(0.5 * g), 0.2, -0.4);
+    turn[g] = t - t.dot(nb) * nb;
+  }
+  const std::vector<Vec3> dxt = m_response_with_turn(m, planes, x0, R0, shift, turn);
+  const std::vector<Vec3> tp = solved_points(h, turn), tm = solved_points(-h, turn);
+  double err_t = 0.0, size_t_ = 0.0, turned = 0.0;
+  for (int g = 0; g < ng; ++g) {
+    const Vec3 fd = (tp[g] - tm[g]) / (2.0 * h);
+    err_t = std::max(err_t, (fd - dxt[g]).norm());
+    size_t_ = std::max(size_t_, fd.norm());
+    turned = std::max(turned, (dxt[g] - dx[g]).norm());
+  }
+  std::printf("with turned normals %.3e (the turn's part %.3e), difference to the solves %.2e\n", size_t_, turned,
+              err_t);
+  ASSERT_GT(turned, 0.01);  // the turn moves the points
+  EXPECT_LT(err_t, 1e-5 * size_t_);
 }

@@ -38,37 +38,42 @@ TEST(NewtonKrylov, FailedProductGivesThePlainUpdate) {
 }
 
 namespace {
-// A beam whose linearized response moves point i along +x by a·shift_i (one plane per point).
+// A beam whose linearized response moves point i along +x by a·shift_i + a2·turn_i·y (one plane
+// per point).
 struct LinearBeam : test::SpringBeam {
-  explicit LinearBeam(int points, double a) : test::SpringBeam(points), a(a) {}
-  double a;
+  explicit LinearBeam(int points, double a, double a2) : test::SpringBeam(points), a(a), a2(a2) {}
+  double a, a2;
   participant::SolveStats solve_with_planes(const std::vector<participant::Vec3>&,
                                             const participant::ContactPlanes&) override {
     participant::SolveStats st;
     st.converged = true;
     return st;
   }
-  participant::SolveStats linear_response(const std::vector<double>& shift,
+  participant::SolveStats linear_response(const std::vector<double>& shift, const std::vector<participant::Vec3>& turn,
                                           std::vector<participant::Vec3>& dx) override {
     dx.assign(shift.size(), {0.0, 0.0, 0.0});
-    for (std::size_t i = 0; i < shift.size(); ++i) dx[i][0] = a * shift[i];
+    for (std::size_t i = 0; i < shift.size(); ++i) dx[i][0] = a * shift[i] + (turn.empty() ? 0.0 : a2 * turn[i][1]);
     participant::SolveStats st;
     st.converged = true;
     return st;
   }
 };
-// A solid whose plane j moves along its normal by b·dx_j·x.
+// A solid whose plane j moves along its normal by b·dx_j·x and whose normal turns by c·dx_j·x along y.
 struct LinearSolid : participant::SolidParticipant {
-  double b;
-  explicit LinearSolid(double b) : b(b) {}
+  double b, c;
+  LinearSolid(double b, double c) : b(b), c(c) {}
   void begin_step(int, double) override {}
   participant::SolveStats solve(const participant::SamplePoints&, participant::ContactReply&, double) override {
     return {};
   }
-  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx,
-                                          std::vector<double>& shift) override {
+  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx, std::vector<double>& shift,
+                                          std::vector<participant::Vec3>& turn) override {
     shift.clear();
-    for (const auto& d : dx) shift.push_back(b * d[0]);
+    turn.clear();
+    for (const auto& d : dx) {
+      shift.push_back(b * d[0]);
+      turn.push_back({0.0, c * d[0], 0.0});
+    }
     participant::SolveStats st;
     st.converged = true;
     return st;
@@ -80,13 +85,15 @@ struct LinearSolid : participant::SolidParticipant {
 
 // Consistency of the composition: with plain planes (normals +x) the map's derivative along v is
 // b·a·(n·v) n per plane, the chain of the two participants' responses; planes without a plane in the
-// reply get none. The scheme differences the planes made of the participants' responses over 1e-6
+// reply get none. With the normals as unknowns (v twice as long: points, then normals) a turn of
+// the normals (its part across them) moves the points too, and the solid's turn of its normals is
+// the normals' part of the derivative. The scheme differences the planes made of the participants' responses over 1e-6
 // of the largest one (here 1.2 mm of a point's move) at positions of about 1 mm: round-off of
 // 2e-16 / 1e-6 relative to the largest response, up to 1e-8 of the smallest (0.024): bound 1e-7.
 TEST(NewtonKrylov, RobinMapDerivativeChainsTheParticipantsResponses) {
   const int n = 5;
-  LinearBeam beam(n, 0.8);
-  LinearSolid solid(-0.3);
+  LinearBeam beam(n, 0.8, 0.5);
+  LinearSolid solid(-0.3, 0.2);
   coupler::Robin robin(n, false);
   participant::SamplePoints x = beam.sample_points();
   participant::ContactReply reply;
@@ -113,5 +120,15 @@ TEST(NewtonKrylov, RobinMapDerivativeChainsTheParticipantsResponses) {
     EXPECT_NEAR(jv[3 * i], expected, 1e-7 * std::abs(0.8 * 0.3 * v[3 * i])) << "plane " << i;
     EXPECT_EQ(jv[3 * i + 1], 0.0);
     EXPECT_EQ(jv[3 * i + 2], 0.0);
+  }
+  Eigen::VectorXd w(6 * n);
+  for (int k = 0; k < 6 * n; ++k) w[k] = 0.05 * (k % 7) - 0.1;
+  const Eigen::VectorXd jw = robin.map_derivative(beam, solid, w);
+  ASSERT_EQ(jw.size(), 6 * n);
+  for (int i = 0; i < n; ++i) {
+    const double move = i == 3 ? 0.0 : 0.8 * w[3 * i] + 0.5 * w[3 * n + 3 * i + 1];  // dx of point i along x
+    EXPECT_NEAR(jw[3 * i], -0.3 * move, 1e-7 * 0.3) << "plane " << i;
+    EXPECT_NEAR(jw[3 * n + 3 * i + 1], 0.2 * move, 1e-7 * 0.2) << "normal " << i;
+    EXPECT_NEAR(jw[3 * n + 3 * i], 0.0, 1e-7 * 0.2) << "normal " << i;  // the turn is across the normal
   }
 }

@@ -58,7 +58,7 @@ TEST(CouplingSummary, FailedRunErrorRoundTrips) {
   EXPECT_EQ(keys, (std::vector<std::string>{"status", "error", "steps", "rejected_attempts", "prediction_retries",
                                             "coupling_iterations_total", "coupling_iterations_mean",
                                             "coupling_iterations_max", "wall_time", "beam_time", "solid_time",
-                                            "messaging_time", "messaging_share"}));
+                                            "messaging_time", "messaging_share", "jacobian_products", "product_time"}));
 }
 
 TEST(CouplingSummary, OkRunAndNonFiniteTimes) {

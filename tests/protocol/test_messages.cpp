@@ -36,6 +36,26 @@ TEST(Messages, BeamSolveRequestRoundTrip) {
   EXPECT_EQ(msg::to_vec3s(r.line_loads()), q);
 }
 
+// The interface Newton–Krylov's requests and replies carry their vectors unchanged.
+TEST(Messages, LinearResponsesRoundTrip) {
+  const std::vector<double> shift = {0.5, -1e-7, 0.0};
+  const std::vector<participant::Vec3> turn = {{0, 0.1, 0}, {1e-9, 0, -2}, {0, 0, 0}};
+  const auto& beam = msg::payload_as<fb::BeamLinearRequest>(
+      msg::open(msg::beam_linear_request(coupler(3), 4, 1, shift, turn), "run-A"));
+  EXPECT_EQ(beam.step(), 4u);
+  EXPECT_EQ(msg::to_doubles(beam.plane_shift()), shift);
+  EXPECT_EQ(msg::to_vec3s(beam.normal_turn()), turn);
+  participant::SolveStats st;
+  st.converged = true;
+  const auto& solid = msg::payload_as<fb::SolidLinearReply>(
+      msg::open(msg::solid_linear_reply(coupler(4), st, 0.01, shift, turn), "run-A"));
+  EXPECT_TRUE(msg::to_stats(solid.stats()).converged);
+  EXPECT_EQ(msg::to_doubles(solid.plane_shift()), shift);
+  EXPECT_EQ(msg::to_vec3s(solid.normal_turn()), turn);
+  EXPECT_STREQ(msg::request_verb(fb::Payload::BeamLinearRequest), "linearize");
+  EXPECT_STREQ(msg::request_verb(fb::Payload::SolidLinearRequest), "linearize");
+}
+
 TEST(Messages, SolidSolveRoundTrip) {
   auto pts = points(5);
   auto req = msg::solid_solve_request(coupler(1), 1, 0, pts, 2.5e-3);
@@ -198,6 +218,8 @@ TEST(Messages, StepStateAcceptsTheProtocolOrderOnly) {
   ok(s, msg::hello(coupler(++n), "test"));
   refused(s, msg::step_end(coupler(++n), 1, true), "outside a step");
   refused(s, msg::solid_solve_request(coupler(++n), 1, 0, pts, 0.0), "outside a step");
+  refused(s, msg::beam_linear_request(coupler(++n), 1, 0, {}, {}), "outside a step");
+  refused(s, msg::solid_linear_request(coupler(++n), 1, 0, {}), "outside a step");
   refused(s, msg::step_begin(coupler(++n), 1, std::nan(""), 0.1), "expected finite values");
   refused(s, msg::step_begin(coupler(++n), 1, 0.1, -0.1), "increment >= 0");
   EXPECT_FALSE(s.in_step());
@@ -206,6 +228,9 @@ TEST(Messages, StepStateAcceptsTheProtocolOrderOnly) {
   refused(s, msg::beam_solve_request(coupler(++n), 2, 0, {}), "while step 1 is open");
   ok(s, msg::beam_solve_request(coupler(++n), 1, 0, {}));
   ok(s, msg::solid_solve_request(coupler(++n), 1, 1, pts, 0.0));
+  ok(s, msg::beam_linear_request(coupler(++n), 1, 1, {}, {}));
+  ok(s, msg::solid_linear_request(coupler(++n), 1, 1, {}));
+  refused(s, msg::solid_linear_request(coupler(++n), 2, 1, {}), "while step 1 is open");
   refused(s, msg::solid_solve_request(coupler(++n), 1, 2, pts, std::nan("")), "expected a finite value >= 0");
   refused(s, msg::solid_solve_request(coupler(++n), 1, 2, pts, -1e-3), "expected a finite value >= 0");
   refused(s, msg::step_end(coupler(++n), 2, false), "while step 1 is open");

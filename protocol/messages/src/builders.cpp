@@ -96,9 +96,11 @@ Buffer solid_solve_reply(const Header& h, const participant::SolveStats& s, doub
 }
 
 Buffer beam_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                           const std::vector<double>& plane_shift) {
-  FlatBufferBuilder b(64 + 8 * plane_shift.size());
-  auto p = fb::CreateBeamLinearRequest(b, step, iteration, b.CreateVector(plane_shift));
+                           const std::vector<double>& plane_shift, const std::vector<participant::Vec3>& normal_turn) {
+  FlatBufferBuilder b(64 + 8 * plane_shift.size() + 24 * normal_turn.size());
+  const auto shift = b.CreateVector(plane_shift);
+  const auto turn = vec3s(b, normal_turn);
+  auto p = fb::CreateBeamLinearRequest(b, step, iteration, shift, turn);
   return finish(b, h, fb::Payload::BeamLinearRequest, p.Union());
 }
 
@@ -118,10 +120,12 @@ Buffer solid_linear_request(const Header& h, std::uint32_t step, std::uint32_t i
 }
 
 Buffer solid_linear_reply(const Header& h, const participant::SolveStats& s, double wall,
-                          const std::vector<double>& plane_shift) {
-  FlatBufferBuilder b(256 + 8 * plane_shift.size());
+                          const std::vector<double>& plane_shift, const std::vector<participant::Vec3>& normal_turn) {
+  FlatBufferBuilder b(256 + 8 * plane_shift.size() + 24 * normal_turn.size());
   auto st = stats(b, s, wall);
-  auto p = fb::CreateSolidLinearReply(b, st, b.CreateVector(plane_shift));
+  const auto shift = b.CreateVector(plane_shift);
+  const auto turn = vec3s(b, normal_turn);
+  auto p = fb::CreateSolidLinearReply(b, st, shift, turn);
   return finish(b, h, fb::Payload::SolidLinearReply, p.Union());
 }
 

@@ -126,8 +126,10 @@ SolveStats RemoteBeam::solve_(const std::vector<Vec3>& q, const ContactPlanes* p
   return msg::to_stats(r.stats());
 }
 
-SolveStats RemoteBeam::linear_response(const std::vector<double>& plane_shift, std::vector<Vec3>& dx) {
-  auto b = ch_.call([&](const msg::Header& h) { return msg::beam_linear_request(h, step_, iteration_, plane_shift); });
+SolveStats RemoteBeam::linear_response(const std::vector<double>& plane_shift, const std::vector<Vec3>& normal_turn,
+                                       std::vector<Vec3>& dx) {
+  auto b = ch_.call(
+      [&](const msg::Header& h) { return msg::beam_linear_request(h, step_, iteration_, plane_shift, normal_turn); });
   const auto& r = reply_as<fb::BeamLinearReply>(b);
   account(ch_, r.stats());
   dx = msg::to_vec3s(r.dx());
@@ -172,11 +174,13 @@ SolveStats RemoteSolid::solve(const SamplePoints& pts, ContactReply& reply, doub
   return msg::to_stats(r.stats());
 }
 
-SolveStats RemoteSolid::linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift) {
+SolveStats RemoteSolid::linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift,
+                                        std::vector<Vec3>& normal_turn) {
   auto b = ch_.call([&](const msg::Header& h) { return msg::solid_linear_request(h, step_, iteration_, dx); });
   const auto& r = reply_as<fb::SolidLinearReply>(b);
   account(ch_, r.stats());
   plane_shift = msg::to_doubles(r.plane_shift());
+  normal_turn = msg::to_vec3s(r.normal_turn());
   return msg::to_stats(r.stats());
 }
 

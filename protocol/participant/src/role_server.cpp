@@ -160,10 +160,12 @@ int serve(BeamParticipant& beam, const ServeOptions& o) {
         return msg::beam_solve_reply(h, stats, seconds_since(t0), beam.sample_points());
       }
       case fb::Payload::BeamLinearRequest: {
-        const auto shift = msg::to_doubles(env.payload_as_BeamLinearRequest()->plane_shift());
+        const auto& r = *env.payload_as_BeamLinearRequest();
+        const auto shift = msg::to_doubles(r.plane_shift());
+        const auto turn = msg::to_vec3s(r.normal_turn());
         std::vector<Vec3> dx;
         const auto t0 = Clock::now();
-        SolveStats stats = beam.linear_response(shift, dx);
+        SolveStats stats = beam.linear_response(shift, turn, dx);
         return msg::beam_linear_reply(h, stats, seconds_since(t0), dx);
       }
       case fb::Payload::StepEnd:
@@ -196,9 +198,10 @@ int serve(SolidParticipant& solid, const ServeOptions& o) {
       case fb::Payload::SolidLinearRequest: {
         const auto dx = msg::to_vec3s(env.payload_as_SolidLinearRequest()->dx());
         std::vector<double> shift;
+        std::vector<Vec3> turn;
         const auto t0 = Clock::now();
-        SolveStats stats = solid.linear_response(dx, shift);
-        return msg::solid_linear_reply(h, stats, seconds_since(t0), shift);
+        SolveStats stats = solid.linear_response(dx, shift, turn);
+        return msg::solid_linear_reply(h, stats, seconds_since(t0), shift, turn);
       }
       case fb::Payload::StepEnd:
         solid.end_step(env.payload_as_StepEnd()->accept());

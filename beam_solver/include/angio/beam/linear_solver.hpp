@@ -17,7 +17,14 @@ class LinearSolver {
   virtual const char* name() const = 0;
   // Solves K x = b. The sparsity pattern is analysed once and reused while it stays the same.
   // Throws std::runtime_error when the factorization fails (singular matrix).
-  virtual Eigen::VectorXd solve(const SpMat& K, const Eigen::VectorXd& b) = 0;
+  Eigen::VectorXd solve(const SpMat& K, const Eigen::VectorXd& b) {
+    factorize(K);
+    return solve(b);
+  }
+  // The same in two parts: K factorized once, then any number of right-hand sides. K must live as
+  // long as the solves (UMFPACK's solve reads the matrix again).
+  virtual void factorize(const SpMat& K) = 0;
+  virtual Eigen::VectorXd solve(const Eigen::VectorXd& b) = 0;
 };
 
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name);

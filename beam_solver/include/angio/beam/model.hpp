@@ -157,11 +157,11 @@ class BeamModel {
   void set_sample_planes(std::vector<SamplePlane> planes);
   const std::vector<SamplePlane>& sample_planes() const { return planes_; }
   // Linearized response at the current state (the interface Newton–Krylov, docs/design.md §5.5):
-  // the sample points' displacement (mm per unit of `shift`) when plane i moves by shift[i] along its
-  // normal, K du = −∂r/∂shift with the tangent here (the planes' penalty included). The state is left
-  // as it was. Throws std::invalid_argument if shift is not one value per plane, std::runtime_error
-  // if the tangent cannot be factorized.
-  std::vector<Vec3> plane_response(const std::vector<double>& shift);
+  // the sample points' displacement when plane i moves by shift[i] along its normal and its normal
+  // turns by turn[i] (empty: no turn), K du = −∂r/∂(shift, turn) with the tangent here (the planes'
+  // penalty included). The state is left as it was. Throws std::invalid_argument if shift (or a
+  // non-empty turn) is not one value per plane, std::runtime_error if the tangent cannot be factorized.
+  std::vector<Vec3> plane_response(const std::vector<double>& shift, const std::vector<Vec3>& turn = {});
   // Sample line loads plus the planes' penalty loads at the current configuration (N/mm).
   std::vector<Vec3> sample_contact_loads() const;
   const std::vector<Vec3>& sample_line_loads() const { return q_ext_; }
@@ -229,6 +229,19 @@ class BeamModel {
   std::vector<double> gauss_xi_, gauss_w_;
   double time_ = 0;
   std::unique_ptr<LinearSolver> lin_;
+  // plane_response()'s tangent, factorized once per state: the state, planes and loads it was made
+  // at (compared on every call: a solve, a commit or new planes make it stale) and the residual there
+  struct ResponseTangent {
+    std::vector<Vec3> x, q;
+    std::vector<Quat> R;
+    std::vector<SamplePlane> planes;
+    double time = 0.0;
+    Eigen::VectorXd r;
+    SpMat K;  // factorized in lin, which may read it again in its solves (UMFPACK does)
+    std::unique_ptr<LinearSolver> lin;
+    bool matches(const BeamModel& m) const;
+  };
+  ResponseTangent response_;
 };
 
 // Gauss–Legendre points on [0, 1] and weights summing to 1 (n = 1..6).

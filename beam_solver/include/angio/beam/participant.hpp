@@ -24,6 +24,7 @@ class BeamSolverParticipant : public participant::BeamParticipant {
   participant::SolveStats solve_with_planes(const std::vector<participant::Vec3>& line_loads,
                                             const participant::ContactPlanes& planes) override;
   participant::SolveStats linear_response(const std::vector<double>& plane_shift,
+                                          const std::vector<participant::Vec3>& normal_turn,
                                           std::vector<participant::Vec3>& dx) override;
   void end_step(bool accept) override;
   void finish() override;

@@ -45,7 +45,9 @@ struct RunReport {
   // s in solves over every attempt, rejected steps included
   double beam_time = 0.0;
   double solid_time = 0.0;
-  bool interrupted = false;  // stopped after a committed step at the callback's request (StopRequested)
+  long products = 0;          // newton-krylov: Jacobian-vector products, every attempt
+  double product_time = 0.0;  // s in them
+  bool interrupted = false;   // stopped after a committed step at the callback's request (StopRequested)
 };
 
 // Thrown by a StepCallback to stop the run after the step it was called for (committed): run_coupled

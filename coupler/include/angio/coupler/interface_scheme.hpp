@@ -35,9 +35,9 @@ class InterfaceScheme {
   // Next iterate through the acceleration (iteration k of the step, 0-based).
   virtual void next_iterate(Acceleration& acc, int k) = 0;
   // The derivative of the map (iterate -> the solid's reply as an iterate) along v at the last
-  // iterate, from the participants' linearized responses at their last solves (newton-krylov; call
-  // between force_residual() and next_iterate()). Empty when a participant cannot linearize or the
-  // scheme has no such derivative.
+  // iterate, from the participants' linearized responses at their last solves (newton-krylov; called
+  // by the acceleration inside next_iterate(), with v shaped as the iterate it passes). Empty when a
+  // participant cannot linearize or the scheme has no such derivative.
   virtual Eigen::VectorXd map_derivative(participant::BeamParticipant& beam, participant::SolidParticipant& solid,
                                          const Eigen::VectorXd& v) {
     (void)beam, (void)solid, (void)v;

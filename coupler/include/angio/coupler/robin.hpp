@@ -24,6 +24,11 @@
 // bears on struts where the balloon does not press would otherwise keep the bare penalty). The beam then sees
 // the interface's tangent in this diagonal model; the map stays a function of the iterate (IQN's
 // secants hold) and at the fixed point both laws carry the solid's load.
+//
+// With an acceleration that takes the map's Jacobian (newton-krylov) the planes' normals are
+// unknowns as well (the iterate is the points, then the normals): the solid turns them as its
+// surface deforms, the beam answers a turn with its soft sliding modes, and taken from the last
+// reply as they are they converge only by plain substitution (docs/design.md §5.5).
 #pragma once
 
 #include <vector>

@@ -93,8 +93,8 @@ class SolidRunner : public participant::SolidParticipant {
   participant::SolveStats solve(const participant::SamplePoints& beam_points, participant::ContactReply& reply,
                                 double tolerance) override;
   // Collective; the shifts on rank 0 (the other ranks' left empty).
-  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx,
-                                          std::vector<double>& plane_shift) override;
+  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx, std::vector<double>& plane_shift,
+                                          std::vector<participant::Vec3>& normal_turn) override;
   void end_step(bool accept) override;
   void finish() override;
 
@@ -156,6 +156,11 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
   std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
   participant::SamplePoints points_;        // and with their weights and radii (linear_response)
+  // linear_response's start: the last solve of this step converged, its reply (complete on rank 0)
+  // and the stent contact's forces on this rank's owned nodes there (empty until a response asks)
+  bool linearizable_ = false;
+  participant::ContactReply linear_reply_;
+  std::vector<Vec3d> linear_forces_;
   // The last converged solve of the step (pseudo-time and sample points) and of the last committed
   // step: where a continuation starts from.
   double ok_time_ = 0.0, committed_ok_time_ = 0.0;
@@ -179,8 +184,8 @@ class MpiSolidParticipant : public participant::SolidParticipant {
   void begin_step(int step, double time) override;
   participant::SolveStats solve(const participant::SamplePoints& beam_points, participant::ContactReply& reply,
                                 double tolerance) override;
-  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx,
-                                          std::vector<double>& plane_shift) override;
+  participant::SolveStats linear_response(const std::vector<participant::Vec3>& dx, std::vector<double>& plane_shift,
+                                          std::vector<participant::Vec3>& normal_turn) override;
   void end_step(bool accept) override;
   void finish() override;
   // Releases the followers if finish() was never called (e.g. the coupler vanished).

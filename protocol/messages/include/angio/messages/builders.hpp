@@ -29,16 +29,16 @@ Buffer solid_solve_request(const Header& h, std::uint32_t step, std::uint32_t it
 Buffer solid_solve_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
                          const participant::ContactReply& contact);
 // Linearized responses at the last solve (the interface Newton–Krylov): per plane a shift along its
-// normal (mm) to the beam, the sample points' displacement back; the points' displacement to the
-// solid, per plane its shift back.
+// normal (mm) and a turn of the normal to the beam, the sample points' displacement back; the points'
+// displacement to the solid, per plane its shift and turn back.
 Buffer beam_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
-                           const std::vector<double>& plane_shift);
+                           const std::vector<double>& plane_shift, const std::vector<participant::Vec3>& normal_turn);
 Buffer beam_linear_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
                          const std::vector<participant::Vec3>& dx);
 Buffer solid_linear_request(const Header& h, std::uint32_t step, std::uint32_t iteration,
                             const std::vector<participant::Vec3>& dx);
 Buffer solid_linear_reply(const Header& h, const participant::SolveStats& stats, double wall_time,
-                          const std::vector<double>& plane_shift);
+                          const std::vector<double>& plane_shift, const std::vector<participant::Vec3>& normal_turn);
 Buffer step_end(const Header& h, std::uint32_t step, bool accept);
 Buffer ack(const Header& h);
 Buffer shutdown(const Header& h, const std::string& reason);

@@ -28,11 +28,13 @@ class BeamParticipant {
     return s;
   }
   // Interface Newton–Krylov (docs/design.md §5.5): the sample points' displacement dx (3 per point)
-  // when plane j of the last solve_with_planes() moves by plane_shift[j] along its normal (mm),
-  // linearized at the state that solve left: the beam's tangent with the planes' penalty. Nothing is
-  // solved anew or kept. Participants that cannot do this keep this default (a failed stats saying so).
-  virtual SolveStats linear_response(const std::vector<double>& plane_shift, std::vector<Vec3>& dx) {
-    (void)plane_shift;
+  // when plane j of the last solve_with_planes() moves by plane_shift[j] along its normal (mm) and its
+  // normal turns by normal_turn[j] (perpendicular to it; empty: no turn), linearized at the state that
+  // solve left: the beam's tangent with the planes' penalty. Nothing is solved anew or kept.
+  // Participants that cannot do this keep this default (a failed stats saying so).
+  virtual SolveStats linear_response(const std::vector<double>& plane_shift, const std::vector<Vec3>& normal_turn,
+                                     std::vector<Vec3>& dx) {
+    (void)plane_shift, (void)normal_turn;
     dx.clear();
     SolveStats s;
     s.message = "this beam participant has no linearized response (coupling.acceleration newton-krylov)";

@@ -83,7 +83,8 @@ class RemoteBeam : public BeamParticipant {
   void begin_step(int step, double time) override;
   SolveStats solve(const std::vector<Vec3>& line_loads) override;
   SolveStats solve_with_planes(const std::vector<Vec3>& line_loads, const ContactPlanes& planes) override;
-  SolveStats linear_response(const std::vector<double>& plane_shift, std::vector<Vec3>& dx) override;
+  SolveStats linear_response(const std::vector<double>& plane_shift, const std::vector<Vec3>& normal_turn,
+                             std::vector<Vec3>& dx) override;
   void end_step(bool accept) override;
   void finish() override;  // sends Shutdown
   void set_iteration(int k) { iteration_ = k; }
@@ -103,7 +104,8 @@ class RemoteSolid : public SolidParticipant {
   std::string hello();
   void begin_step(int step, double time) override;
   SolveStats solve(const SamplePoints& beam_points, ContactReply& reply, double tolerance) override;
-  SolveStats linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift) override;
+  SolveStats linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift,
+                             std::vector<Vec3>& normal_turn) override;
   void end_step(bool accept) override;
   void finish() override;
   void set_iteration(int k) { iteration_ = k; }

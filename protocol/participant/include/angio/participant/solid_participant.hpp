@@ -17,12 +17,15 @@ class SolidParticipant {
   // for this solve (inexact solves inside the coupling loop); 0: the participant's own tolerance.
   virtual SolveStats solve(const SamplePoints& beam_points, ContactReply& reply, double tolerance) = 0;
   // Interface Newton–Krylov (docs/design.md §5.5): how far each contact plane of the last solve's
-  // reply moves along its normal (plane_shift, as that reply's planes) when the sample points move by
-  // dx, linearized at the state that solve left (the solid's tangent as last factorized). Nothing is
-  // solved anew or kept. Default: a failed stats saying it is not supported.
-  virtual SolveStats linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift) {
+  // reply moves along its normal (plane_shift, as that reply's planes) and how its normal turns
+  // (normal_turn) when the sample points move by dx, linearized at the state that solve left (the
+  // solid's tangent as last factorized). Nothing is solved anew or kept. Default: a failed stats
+  // saying it is not supported.
+  virtual SolveStats linear_response(const std::vector<Vec3>& dx, std::vector<double>& plane_shift,
+                                     std::vector<Vec3>& normal_turn) {
     (void)dx;
     plane_shift.clear();
+    normal_turn.clear();
     SolveStats s;
     s.message = "this solid participant has no linearized response (coupling.acceleration newton-krylov)";
     return s;
