@@ -171,7 +171,6 @@ void SolidRunner::begin_step(int step, double time) {
 participant::SolveStats SolidRunner::solve(const participant::SamplePoints& pts, participant::ContactReply& reply,
                                            double tolerance) {
   if (stent_contact_) stent_contact_->set_points(pts);
-  stent_x_ = pts.x;
   points_ = pts;
   if (!pts.x.empty() && !stent_contact_ && !warned_contact_ && rank_ == 0) {
     LOG_WARN("solid: no stent contact configured; " << pts.x.size()
@@ -427,9 +426,9 @@ void SolidRunner::artery_measures_(StepSummary& s, std::vector<double>& contact_
   std::vector<Vec3d> x(lumen_nodes_.size());  // held on every rank: the lumen's diameters read these
   for (std::size_t i = 0; i < x.size(); ++i) x[i] = model_->position(lumen_nodes_[i]);
   s.lumen_diameter = lumen_.diameters(x, &s.lumen_centroid);
-  if (!stent_x_.empty()) {  // where the stent sits, in the station coordinate of the lumen profile
+  if (!points_.x.empty()) {  // where the stent sits, in the station coordinate of the lumen profile
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const auto& p : stent_x_) {
+    for (const auto& p : points_.x) {
       const double st = scene_.lumen->station(Vec3d(p[0], p[1], p[2]));
       lo = std::min(lo, st);
       hi = std::max(hi, st);

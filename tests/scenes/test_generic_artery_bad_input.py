@@ -68,14 +68,14 @@ CASES = [
     (
         "newton-krylov without robin planes",
         lambda s: (
-            s["coupling"].pop("iqn"),
+            s["coupling"].pop("iqn", None),
             s["coupling"].update(scheme="dirichlet-neumann", surface_compliance=False, acceleration="newton-krylov"),
         ),
         "coupling.acceleration",
     ),
     (
         "newton_krylov section with another acceleration",
-        lambda s: s["coupling"].update(newton_krylov={"max_products": 5}),
+        lambda s: s["coupling"].update(acceleration="iqn-imvj", newton_krylov={"max_products": 5}),
         "coupling.newton_krylov",
     ),
     # absurd values inside the type's range: a pressure in Pa or kPa taken for MPa

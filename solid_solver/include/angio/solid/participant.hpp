@@ -154,8 +154,7 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<double> endothelium_area_;  // lumped nodal area of artery_inner per owned node (0 off the lumen)
   std::vector<int> lumen_nodes_;          // the lumen profile's nodes (held on every rank)
   std::vector<std::pair<std::string, ContactModel*>> contact_reports_;
-  std::vector<participant::Vec3> stent_x_;  // beam sample points of the last solve (stent extent)
-  participant::SamplePoints points_;        // and with their weights and radii (linear_response)
+  participant::SamplePoints points_;  // beam sample points of the last solve (stent extent, linear_response)
   // linear_response's start: the last solve of this step converged, its reply (complete on rank 0)
   // and the stent contact's forces on this rank's owned nodes there (empty until a response asks)
   bool linearizable_ = false;
