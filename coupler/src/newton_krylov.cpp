@@ -78,7 +78,6 @@ namespace angio::coupler {
 Eigen::VectorXd NewtonKrylov::update(const Eigen::VectorXd& q, const Eigen::VectorXd& r, int) {
   const std::vector<Eigen::Index> dropped = take_discontinuous();
   last_products_ = 0;
-  last_linear_residual_ = 1.0;
   if (!jacobian_ || r.squaredNorm() == 0.0) return q + r;
   const InterfaceOperator A(jacobian_, dropped, r.size());
   Eigen::GMRES<InterfaceOperator, Eigen::IdentityPreconditioner> gmres;
@@ -94,8 +93,7 @@ Eigen::VectorXd NewtonKrylov::update(const Eigen::VectorXd& q, const Eigen::Vect
     return q + r;
   }
   last_products_ = A.products;
-  last_linear_residual_ = gmres.error();
-  LOG_DEBUG("newton-krylov: " << last_products_ << " products, linear residual " << last_linear_residual_
+  LOG_DEBUG("newton-krylov: " << last_products_ << " products, linear residual " << gmres.error()
                               << ", |delta| / |r| = " << delta.norm() / r.norm());
   if (!delta.allFinite()) return q + r;
   return q + delta;

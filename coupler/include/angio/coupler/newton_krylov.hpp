@@ -34,12 +34,10 @@ class NewtonKrylov : public Acceleration {
   double last_factor() const override { return 1.0; }
   std::string name() const override { return "newton-krylov"; }
   int last_products() const { return last_products_; }
-  double last_linear_residual() const { return last_linear_residual_; }  // |r − (I − J)δ| / |r|
 
  private:
   NewtonKrylovOptions o_;
   int last_products_ = 0;
-  double last_linear_residual_ = 0.0;
 };
 
 }  // namespace angio::coupler
