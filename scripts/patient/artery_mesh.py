@@ -424,12 +424,7 @@ def build_artery(
         if samples[2].size and samples[2].min() <= 0.0:
             # a mid-edge node pulled onto the curved boundary can invert a thin element: untangle
             # with gmsh's optimizer, and straighten what it leaves inverted
-            gmsh.option.setNumber("Mesh.HighOrderOptimize", 2)
-            try:
-                gmsh.model.mesh.optimize("HighOrder")
-            except Exception as e:  # gmsh raises a bare Exception when it cannot reach its target
-                log(f"patient: gmsh's high-order optimization stopped ({' '.join(str(e).split())})")
-            samples = _jacobian_samples()  # of the optimized mesh
+            samples = _optimize_high_order(log)
         straightened, still_inverted, samples = _straighten_inverted(samples)
         if straightened:
             log(
@@ -617,6 +612,35 @@ def _shape_quality(corners):
 
 # gmsh tet10 mid-edge nodes 4..9 on the edges 01 12 20 30 32 31 (gmsh manual, "Node ordering")
 TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
+
+
+def _optimize_high_order(log):
+    """gmsh's high-order optimizer on the mesh as it is; returns _jacobian_samples() of the result.
+    The optimizer also moves corner nodes, and its patches are visited in an order that is not the
+    same from run to run (seen: the same scene meshed valid on one machine and with a corner
+    tetrahedron inverted, scaled Jacobian -4.55, on another). Straightening cannot mend an inverted
+    corner tetrahedron, so when the optimizer leaves one its result is discarded: every node goes back
+    where it was, and _straighten_inverted, valid whenever the tet4 are, takes over."""
+    import gmsh
+
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    before = np.asarray(coords).reshape(-1, 3)
+    gmsh.option.setNumber("Mesh.HighOrderOptimize", 2)
+    try:
+        gmsh.model.mesh.optimize("HighOrder")
+    except Exception as e:  # gmsh raises a bare Exception when it cannot reach its target
+        log(f"patient: gmsh's high-order optimization stopped ({' '.join(str(e).split())})")
+    samples = _jacobian_samples()
+    folded = int(np.count_nonzero(samples[3] <= 0.0))
+    if folded:
+        log(
+            f"patient: gmsh's high-order optimization inverted {folded} corner tetrahedra: its result "
+            f"discarded, the elements it was to untangle straightened instead"
+        )
+        for tag, x in zip(tags, before):
+            gmsh.model.mesh.setNode(int(tag), list(x), [])
+        samples = _jacobian_samples()
+    return samples
 
 
 def _straighten_inverted(samples, max_rounds=5):

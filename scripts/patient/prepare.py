@@ -22,7 +22,7 @@ import numpy as np
 import insertion_tool
 import scene_keys
 
-from .artery_mesh import SLIVER_QUALITY, Refinement, WallSpec, build_artery, layer_radii, section_at, section_frames
+from .artery_mesh import SLIVER_QUALITY, Refinement, WallSpec, layer_radii, section_at, section_frames
 from .centerline_csv import read_centerline_csv, write_centerline_csv, write_points
 from .centerline_vtp import read_centerline
 from .errors import PatientInputError
@@ -33,6 +33,7 @@ from .placement import Device, devices_fit, place_device, stenosis_site
 from .plaque import check_within_intima, plaque_materials, read_plaque
 from .plaque_labels import check_types, read_labels, regions_from_labels
 from .plaque_volume import regions_from_mesh
+from .reproducible_mesh import build_artery_reproducibly
 
 # The keys of `patient:` (their types, defaults and ranges) are declared in core/scene/keys.yaml
 # and checked by scene_keys.check_map.
@@ -386,7 +387,7 @@ def prepare_scene(scene, scene_path, out_dir, log=print):
             f"balloon and its margins){' in ' + ', '.join(refine.layers) if refine.layers else ''}, "
             f"{mesh['size']:g} mm elsewhere"
         )
-    info = build_artery(
+    info = build_artery_reproducibly(
         cl.points,
         cl.radius,
         wall_t,

@@ -19,6 +19,8 @@ from patient.artery_mesh import (  # noqa: E402
     TET10_EDGES,
     Refinement,
     WallSpec,
+    _jacobian_samples,
+    _optimize_high_order,
     _shape_quality,
     build_artery,
     layer_radii,
@@ -35,6 +37,7 @@ from patient.placement import (  # noqa: E402
 )
 from patient.deformed_placement import place_on_deformed_lumen  # noqa: E402
 from patient.prepare import add_insertion, refinement_of  # noqa: E402
+from patient.reproducible_mesh import build_artery_reproducibly  # noqa: E402
 
 
 def arc(n=60, length=12.0, bend=20.0, r0=0.9, stenosis=0.25, noise=0.0, seed=1, wiggle=0.0):
@@ -403,6 +406,34 @@ class ArteryMesh(unittest.TestCase):
             with self.assertRaisesRegex(PatientInputError, r"patient.mesh.refine.layers: unknown layer 'intma'"):
                 build(intima_only, Refinement(4, 8, 0.3, 1, ("intma",)))
 
+    def test_the_same_scene_meshes_to_the_same_file(self):
+        """Consistency: gmsh orders some containers by memory address, so the same geometry meshed in
+        two processes differs (seen: nodes 0.03 mm apart) unless the mesher runs with a fixed memory
+        layout; two runs of build_artery_reproducibly, to different files, give the same bytes. Its
+        refusals arrive as build_artery's own."""
+        pts, r, wall = arc(n=40, length=8.0, r0=0.8, stenosis=0.3)
+        spec = WallSpec(media_ratio=0.06, adventitia_ratio=0.065, min_intima=0.05)
+        with tempfile.TemporaryDirectory(prefix=f"patient-same-{os.getpid()}-") as d:
+            files = [Path(d) / "one.msh", Path(d) / "sub" / "second.msh"]
+            files[1].parent.mkdir()
+            infos = [
+                build_artery_reproducibly(pts, r, wall, spec, 0.7, f, binary=True, log=lambda m: None) for f in files
+            ]
+            self.assertEqual([i["file"] for i in infos], [str(f) for f in files])
+            self.assertEqual(files[0].read_bytes(), files[1].read_bytes())
+            with self.assertRaisesRegex(PatientInputError, r"c.csv: patient.mesh.refine.layers: unknown layer 'intma'"):
+                build_artery_reproducibly(
+                    pts,
+                    r,
+                    wall,
+                    spec,
+                    0.7,
+                    files[0],
+                    where="c.csv",
+                    log=lambda m: None,
+                    refine=Refinement(2, 4, 0.3, 1, ("intma",)),
+                )
+
     def test_refinement_refused_when_not_finer(self):
         # checked before the placement is read (None here)
         with self.assertRaisesRegex(PatientInputError, r"s.yaml: patient.mesh.refine.size: expected a size below"):
@@ -429,6 +460,48 @@ class ArteryMesh(unittest.TestCase):
         expected = 6 * math.sqrt(2) * (8.0 / 3.0 * 0.01) / (np.mean(e2) ** 1.5)
         self.assertAlmostEqual(q[2], expected, places=12)
         self.assertLess(q[2], SLIVER_QUALITY * 3)
+
+    def test_optimizer_result_discarded_when_it_inverts_a_corner_tetrahedron(self):
+        """The high-order optimizer may move corner nodes and leave a tet4 inverted, which no
+        straightening mends: then every node is put back where it was before the optimizer ran.
+        Stands in for the optimizer with one that mirrors a corner of an element through its
+        opposite face (that element's tet4 inverted), and with one that only moves a mid-edge node
+        (a result that is kept)."""
+        import gmsh
+
+        def mirror_a_corner(_how):
+            _, nodes, _, _, c = _jacobian_samples()
+            e = int(np.argmax(c[:, :, 2].mean(axis=1)))  # any element: the one highest in z
+            p, a, b, d = c[e]
+            n = np.cross(b - a, d - a)
+            n /= np.linalg.norm(n)
+            gmsh.model.mesh.setNode(int(nodes[e, 0]), list(p - 2.0 * (p - a).dot(n) * n), [])
+
+        def nudge_a_mid_edge_node(_how):
+            _, nodes, _, _, c = _jacobian_samples()
+            gmsh.model.mesh.setNode(int(nodes[0, 4]), list(0.5 * (c[0, 0] + c[0, 1]) + 1e-3), [])
+
+        gmsh.initialize()
+        real = gmsh.model.mesh.optimize
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+            gmsh.model.occ.synchronize()
+            gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+            gmsh.model.mesh.generate(3)
+            gmsh.model.mesh.setOrder(2)
+            _, before, _ = gmsh.model.mesh.getNodes()
+            for fake, kept in ((mirror_a_corner, False), (nudge_a_mid_edge_node, True)):
+                messages = []
+                gmsh.model.mesh.optimize = fake
+                samples = _optimize_high_order(messages.append)
+                _, after, _ = gmsh.model.mesh.getNodes()
+                self.assertEqual(np.array_equal(after, before), not kept, fake.__name__)
+                self.assertEqual(any("discarded" in m for m in messages), not kept, messages)
+                self.assertTrue((samples[3] > 0.0).all(), fake.__name__)  # every tet4 positive
+        finally:
+            gmsh.model.mesh.optimize = real
+            gmsh.finalize()
 
     def test_edge_table_is_gmsh_order(self):
         import gmsh
