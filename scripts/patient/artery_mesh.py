@@ -616,9 +616,9 @@ TET10_EDGES = ((0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1))
 
 def _optimize_high_order(log):
     """gmsh's high-order optimizer on the mesh as it is; returns _jacobian_samples() of the result.
-    The optimizer also moves corner nodes, and its patches are visited in an order that is not the
-    same from run to run (seen: the same scene meshed valid on one machine and with a corner
-    tetrahedron inverted, scaled Jacobian -4.55, on another). Straightening cannot mend an inverted
+    The optimizer also moves corner nodes, and what it does depends on the machine and on gmsh's
+    memory layout (reproducible_mesh.py; seen: the same scene meshed valid on one machine and with a
+    corner tetrahedron inverted, scaled Jacobian -4.55, on another). Straightening cannot mend an inverted
     corner tetrahedron, so when the optimizer leaves one its result is discarded: every node goes back
     where it was, and _straighten_inverted, valid whenever the tet4 are, takes over."""
     import gmsh

@@ -3,18 +3,20 @@ that a scene meshes to the same file every time it is launched.
 
 Why: gmsh 4.8 keeps some of its containers ordered by memory address. With the kernel's address
 space randomization the same geometry and options mesh differently from run to run. Measured on
-configs/patient_like.yaml, two launches a minute apart on one machine: the same 6,398 tet10 and
-connectivity, but 9,265 of the 9,986 nodes up to 0.031 mm apart and the minimal scaled Jacobian
-0.204 in one, 0.062 in the other (and elements stresses several per cent apart). A fixed hash seed
-does not help; without address randomization (util-linux's `setarch --addr-no-randomize`) the two
-files were identical. So the child is started through setarch, with a fixed hash seed and a fixed,
-minimal environment (the environment's size moves the heap too).
+configs/patient_like.yaml, launches a minute apart on one machine: the same 6,398 tet10, but 9,265
+of the 9,986 nodes up to 0.031 mm apart, the minimal scaled Jacobian 0.204 or 0.062, and element
+stresses up to 4 % apart. A fixed hash seed does not help; without address randomization
+(util-linux's `setarch --addr-no-randomize`) the files were identical. So the child is started
+through setarch, with a fixed hash seed and a fixed, minimal environment, and reads nothing that
+names the run: what a process reads moves its heap too (two children given arguments of different
+lengths meshed differently).
 
-Across machines the files may still differ: glibc picks its math kernels by CPU. Validity does not
-depend on it (artery_mesh.py checks and mends every mesh it writes).
+Whether two machines write the same file was not checked; validity does not depend on it
+(artery_mesh.py checks and mends every mesh it writes).
 
-The child reads its arguments from a pickle in its working folder, prints build_artery's log lines, and writes the result
-or the exception it raised to a second pickle; the parent re-raises that exception."""
+The child reads its arguments from a pickle in its working folder, prints build_artery's log
+lines, and writes the result or the exception it raised to a second pickle; the parent re-raises
+that exception."""
 import pickle
 import platform
 import shutil
