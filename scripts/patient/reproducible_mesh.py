@@ -52,10 +52,8 @@ def build_artery_reproducibly(points, radius, wall, spec, mesh_size, out_path, l
     (with `file` the path asked for) and the same exceptions."""
     with tempfile.TemporaryDirectory(prefix="artery-mesh-") as scratch:
         work = Path(scratch)
-        # What the child reads is the same bytes for the same scene wherever the run goes: no
-        # argument, and the mesh file's name relative to its working folder, whose random name it
-        # never sees (-P: not on sys.path). Even such strings move the heap: two launches whose
-        # mesh paths differed meshed differently.
+        # no argument, the mesh file's name relative to the working folder, whose random name the
+        # child never sees (-P: not on sys.path)
         with open(work / "in.pickle", "wb") as f:
             pickle.dump(((points, radius, wall, spec, mesh_size, "artery.msh"), kwargs), f)
         # Every module compiled afresh (an empty bytecode cache, none written): a module loaded from
@@ -70,13 +68,16 @@ def build_artery_reproducibly(points, radius, wall, spec, mesh_size, out_path, l
             "LC_ALL": "C",
         }
         cmd = _fixed_layout_prefix(log) + [sys.executable, "-P", "-m", "patient.reproducible_mesh"]
-        child = subprocess.Popen(cmd, env=env, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        for line in child.stdout:
-            log(line.rstrip("\n"))
-        err = child.stderr.read()
-        child.wait()
+        # stderr to a file: a second pipe could fill while the log lines are read, and both block
+        with open(work / "stderr.txt", "w+") as err:
+            child = subprocess.Popen(cmd, env=env, cwd=work, stdout=subprocess.PIPE, stderr=err, text=True)
+            for line in child.stdout:
+                log(line.rstrip("\n"))
+            child.wait()
+            err.seek(0)
+            stderr = err.read()
         if not (work / "out.pickle").exists():
-            tail = " ".join(err.strip().splitlines()[-3:]) or "no message"
+            tail = " ".join(stderr.strip().splitlines()[-3:])[-500:] or "no message"
             raise RuntimeError(f"the artery mesher exited with code {child.returncode} ({tail})")
         with open(work / "out.pickle", "rb") as f:
             ok, value = pickle.load(f)

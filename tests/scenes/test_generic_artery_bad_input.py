@@ -67,9 +67,8 @@ CASES = [
     ),
     (
         "newton-krylov without robin planes",
-        lambda s: (
-            s["coupling"].pop("iqn", None),
-            s["coupling"].update(scheme="dirichlet-neumann", surface_compliance=False, acceleration="newton-krylov"),
+        lambda s: s["coupling"].update(
+            scheme="dirichlet-neumann", surface_compliance=False, acceleration="newton-krylov"
         ),
         "coupling.acceleration",
     ),
