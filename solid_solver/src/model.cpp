@@ -1156,12 +1156,15 @@ std::string SolidModel::tangent_response(const std::vector<Vec3d>& f, std::vecto
   ANGIO_PETSC(VecRestoreArray(r_, &a));
   ANGIO_PETSC(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
   if (!kept_splits_.empty()) keep_splits_(true);
-  // An iterative solver stops at 1e-3 of the forces here: the Newton–Krylov wants its products to a
+  // An iterative solver stops at 1e-2 of the forces here: the Newton–Krylov wants its products to a
   // few per cent (its GMRES tolerance is 0.1 by default), not to the Newton's own linear tolerance.
+  // Measured on the generic artery (kept artery split): 1e-4, 1e-3 and 1e-2 give the same 242
+  // coupling iterations, the products' solves 23.1 s at 1e-3 and 10.5 s at 1e-2; at 1e-1 their
+  // error shows (254 iterations, 333 against 297 products).
   PetscReal rtol, abstol, dtol;
   PetscInt maxits;
   ANGIO_PETSC(KSPGetTolerances(ksp_, &rtol, &abstol, &dtol, &maxits));
-  ANGIO_PETSC(KSPSetTolerances(ksp_, std::max(rtol, PetscReal(1e-3)), abstol, dtol, maxits));
+  ANGIO_PETSC(KSPSetTolerances(ksp_, std::max(rtol, PetscReal(1e-2)), abstol, dtol, maxits));
   KSPConvergedReason reason;
   {
     OptionsScope scope(options_);

@@ -135,8 +135,11 @@ class SolidRunner : public participant::SolidParticipant {
   std::vector<std::string> nodal_stress_names_;  // their output fields, per block
   double recovery_seconds_ = 0.0;                // all recover() calls (rank 0), summary.json timing
   double stress_summary_seconds_ = 0.0;          // all block_stress_ calls (on rank 0): max, p99, ball average
-  double reply_seconds_ = 0.0;       // the stent contact's replies and per-step gaps outside the solves (rank 0)
-  double state_file_seconds_ = 0.0;  // all state file writes (rank 0's clock), summary.json timing
+  double reply_seconds_ = 0.0;           // the stent contact's replies and per-step gaps outside the solves (rank 0)
+  double state_file_seconds_ = 0.0;      // all state file writes (rank 0's clock), summary.json timing
+  long products_ = 0;                    // linear_response calls, summary.json timing
+  double product_seconds_ = 0.0;         // all linear_response calls (rank 0's clock)
+  double product_linear_seconds_ = 0.0;  // of which the solves with the kept factorization
   bool warned_recovery_ = false;
   std::vector<StepSummary> history_;
   SolveReport last_;
