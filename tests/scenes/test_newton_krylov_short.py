@@ -53,6 +53,10 @@ def run(tmp, name, coupling):
         return None
     summary = json.loads((run_dir / "coupling_summary.json").read_text())
     beam = json.loads((run_dir / "beam" / "summary.json").read_text())
+    solid = json.loads((run_dir / "solid" / "summary.json").read_text())
+    # the solid times every product it answers: its count is the coupler's
+    summary["solid_products"] = solid["timing"]["interface_products"]
+    summary["solid_product_seconds"] = solid["timing"]["interface_product_seconds"]
     log = (run_dir / "coupler.log").read_text()
     return summary, beam["diameter"]["final"], log
 
@@ -74,6 +78,15 @@ with tempfile.TemporaryDirectory() as tmp:
             f"newton-krylov asked the participants for products ({s_nk['jacobian_products']})",
         )
         check(s_iqn["jacobian_products"] == 0, "IQN-IMVJ asked for none")
+        check(
+            s_nk["solid_products"] == s_nk["jacobian_products"] and s_iqn["solid_products"] == 0,
+            f"the solid counted the products it answered ({s_nk['solid_products']}, {s_iqn['solid_products']})",
+        )
+        check(
+            0.0 < s_nk["solid_product_seconds"] <= s_nk["product_time"],
+            f"the solid's product time is part of the coupler's ({s_nk['solid_product_seconds']} s of "
+            f"{s_nk['product_time']} s)",
+        )
         check(abs(d_nk - d_iqn) <= 1e-3, f"stent diameter at 0.5 s: {d_nk:.6f} vs {d_iqn:.6f} mm (within 1e-3 mm)")
         its_nk, its_iqn = s_nk["coupling_iterations_total"], s_iqn["coupling_iterations_total"]
         check(its_nk <= its_iqn, f"coupling iterations {its_nk} <= IQN-IMVJ's {its_iqn}")
