@@ -13,6 +13,10 @@ the largest process, and the stent diameter at peak and final. The same balloon 
 without the stent then runs alone (solid-only scene: same steps, solver and loads, `--no-alone`
 skips it); coupled/alone is the price of the coupling.
 
+A procedure (a scene with `procedure:`) runs whole, as `angio run` runs it, and gives one row per
+coupled phase (`<scene>/<k>-<phase>`, its wall the phase's coupler wall; the whole launch's wall in
+`procedure_wall_s`); it has no alone run.
+
 The rows go to a JSON file (--json, default bench_scenes.json in the output directory);
 --compare OLD.json prints the ratios new/old per scene and the changes of the results.
 Units: s, MiB, mm. Run on an idle machine: the figures are wall times.
@@ -119,6 +123,23 @@ def row_of(name, run_dir, rc, wall, rss):
     }
 
 
+def procedure_rows(name, run_dir, rc, wall, rss):
+    """One row per coupled phase of a procedure's run (<run dir>/<k>-<phase>/ with a coupler's summary)."""
+    rows = []
+    phases = sorted(d for d in os.listdir(run_dir) if os.path.isdir(os.path.join(run_dir, d)) and d[:1].isdigit())
+    for phase in phases:
+        phase_dir = os.path.join(run_dir, phase)
+        c = load(os.path.join(phase_dir, "coupling_summary.json"))
+        if not c:
+            continue  # a solid-only phase (predilatation), or one the procedure did not reach
+        row = row_of(f"{name}/{phase}", phase_dir, 0, c.get("wall_time", float("nan")), rss)
+        row["procedure_wall_s"] = wall
+        rows.append(row)
+    if rc != 0 or not rows:
+        rows.append({**row_of(name, run_dir, rc, wall, rss), "status": f"exit {rc}" if rc else "no coupled phase"})
+    return rows
+
+
 def alone_row(run_dir, rc, wall, rss):
     s = load(os.path.join(run_dir, "solid", "summary.json"))
     t = s.get("timing", {})
@@ -135,9 +156,15 @@ def fmt(v, spec):
     return "-" if v is None else format(v, spec)
 
 
+def scene_width(rows):
+    """The scene column: 26 characters, or the longest name (a procedure's phases) and a space."""
+    return max([26] + [len(r["scene"]) + 1 for r in rows])
+
+
 def print_table(rows):
+    w = scene_width(rows)
     head = (
-        f"{'scene':<26}{'status':>7}{'wall s':>9}{'steps':>6}{'cuts':>5}{'it mean':>8}{'it max':>7}"
+        f"{'scene':<{w}}{'status':>7}{'wall s':>9}{'steps':>6}{'cuts':>5}{'it mean':>8}{'it max':>7}"
         f"{'newton':>7}{'LU':>6}{'solid s':>8}{'assem s':>8}{'(cont.)':>8}{'lin s':>7}{'beam s':>7}{'msg s':>6}"
         f"{'MiB':>6}{'D max':>7}{'D fin':>7}{'alone s':>8}{'c/a':>7}"
     )
@@ -146,7 +173,7 @@ def print_table(rows):
         a = r.get("alone") or {}
         ratio = r["wall_s"] / a["wall_s"] if a.get("wall_s") and a.get("status") == "ok" else None
         print(
-            f"{r['scene']:<26}{r['status']:>7}{r['wall_s']:>9.1f}{fmt(r['steps'], 'd'):>6}{fmt(r['cuts'], 'd'):>5}"
+            f"{r['scene']:<{w}}{r['status']:>7}{r['wall_s']:>9.1f}{fmt(r['steps'], 'd'):>6}{fmt(r['cuts'], 'd'):>5}"
             f"{fmt(r['coupling_iterations_mean'], '.2f'):>8}{fmt(r['coupling_iterations_max'], 'd'):>7}"
             f"{fmt(r['solid_newton_iterations'], 'd'):>7}{fmt(r['solid_factorizations'], 'd'):>6}"
             f"{fmt(r['solid_s'], '.1f'):>8}"
@@ -163,18 +190,19 @@ def compare(rows, old_path):
     if not old:
         sys.exit(f"bench_scenes: {old_path} holds no rows")
     print(f"\nagainst {old_path} (commit {load(old_path).get('commit', '?')}):")
-    print(f"{'scene':<26}{'wall old':>9}{'wall new':>9}{'speedup':>8}{'dD max mm':>11}{'dD fin mm':>11}")
+    w = scene_width(rows)
+    print(f"{'scene':<{w}}{'wall old':>9}{'wall new':>9}{'speedup':>8}{'dD max mm':>11}{'dD fin mm':>11}")
     for r in rows:
         o = old.get(r["scene"])
         if not o:
-            print(f"{r['scene']:<26} (not in the old file)")
+            print(f"{r['scene']:<{w}} (not in the old file)")
             continue
 
         def d(k):
             return None if r.get(k) is None or o.get(k) is None else r[k] - o[k]
 
         print(
-            f"{r['scene']:<26}{o['wall_s']:>9.1f}{r['wall_s']:>9.1f}{o['wall_s'] / r['wall_s']:>8.2f}"
+            f"{r['scene']:<{w}}{o['wall_s']:>9.1f}{r['wall_s']:>9.1f}{o['wall_s'] / r['wall_s']:>8.2f}"
             f"{fmt(d('stent_diameter_max'), '+.4f'):>11}{fmt(d('stent_diameter_final'), '+.4f'):>11}"
         )
 
@@ -204,6 +232,9 @@ def main():
         subprocess.run(["rm", "-rf", run_dir, run_dir + "_alone"])
         print(f"[bench] {name} ...", file=sys.stderr, flush=True)
         rc, wall, rss = launch(path, run_dir, a.build_dir, a.ranks)
+        if "procedure" in yaml.safe_load(open(path)):
+            rows += procedure_rows(name, run_dir, rc, wall, rss)
+            continue
         row = row_of(name, run_dir, rc, wall, rss)
         if not a.no_alone:
             print(f"[bench] {name} alone ...", file=sys.stderr, flush=True)

@@ -9,7 +9,9 @@ Checks what the benchmark table is made of, on real runs (consistency of the boo
     at most one factorization per Newton iteration or solve, contact time part of the assembly time,
     assembly + linear solve within the solid time the coupler measured;
   * the stent diameter comes from report.py (between the crimped 1.15 mm and 3 mm);
-  * --compare against its own JSON prints the scene with a speedup and zero result changes.
+  * --compare against its own JSON prints the scene with a speedup and zero result changes;
+  * a procedure (tests/scenes/data/tiny_procedure.yaml) gives one row per coupled phase, named
+    <scene>/<k>-<phase>, each phase's wall within the whole launch's.
 """
 import json
 import subprocess
@@ -22,6 +24,42 @@ import yaml
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from checklist import check, failures  # noqa: E402
+
+
+def procedure_rows(bin_dir, tmp):
+    scene = ROOT / "tests" / "scenes" / "data" / "tiny_procedure.yaml"
+    out = tmp / "procedure_runs"
+    cmd = [
+        "/usr/bin/python3",
+        str(ROOT / "bench" / "bench_scenes.py"),
+        str(scene),
+        "--no-alone",
+        "--out-dir",
+        str(out),
+        "--build-dir",
+        str(bin_dir.parent),
+    ]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    print(r.stdout[-2000:], r.stderr[-1500:])
+    check(r.returncode == 0, f"bench_scenes.py on a procedure exits 0 (got {r.returncode})")
+    rows = json.load(open(out / "bench_scenes.json"))["rows"]
+    phases = yaml.safe_load(open(scene))["procedure"]
+    # coupled: the phase that deploys the stent and every phase after it (the stent stays)
+    first = next(k for k, p in enumerate(phases) if p.get("stent"))
+    coupled = [f"tiny_procedure/{k + 1}-{p['name']}" for k, p in enumerate(phases) if k >= first]
+    names = [row["scene"] for row in rows]
+    check(names == coupled, f"one row per coupled phase ({names}, expected {coupled})")
+    for row in rows:
+        check(
+            row["status"] == "ok" and row["solid_solves"] >= row["coupling_iterations_total"] > 0,
+            f"{row['scene']}: ok, one solid solve per coupling iteration at least ({row['status']}, "
+            f"{row['solid_solves']}, {row['coupling_iterations_total']})",
+        )
+    walls = [row["wall_s"] for row in rows]
+    check(
+        rows and sum(walls) <= rows[0]["procedure_wall_s"] and all(w > 0 for w in walls),
+        f"the phases' walls {walls} within the launch's {rows[0]['procedure_wall_s'] if rows else None}",
+    )
 
 
 def main():
@@ -92,6 +130,7 @@ def main():
                 float(f[3]) > 0 and f[4] in ("+0.0000", "-0.0000") and f[5] in ("+0.0000", "-0.0000"),
                 f"comparison: a speedup and unchanged diameters ({lines[1]})",
             )
+        procedure_rows(bin_dir, tmp)
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0
 
