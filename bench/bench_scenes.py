@@ -126,7 +126,8 @@ def row_of(name, run_dir, rc, wall, rss):
 def procedure_rows(name, run_dir, rc, wall, rss):
     """One row per coupled phase of a procedure's run (<run dir>/<k>-<phase>/ with a coupler's summary)."""
     rows = []
-    phases = sorted(d for d in os.listdir(run_dir) if os.path.isdir(os.path.join(run_dir, d)) and d[:1].isdigit())
+    listed = os.listdir(run_dir) if os.path.isdir(run_dir) else []  # none where the launch refused the scene
+    phases = sorted(d for d in listed if os.path.isdir(os.path.join(run_dir, d)) and d[:1].isdigit())
     for phase in phases:
         phase_dir = os.path.join(run_dir, phase)
         c = load(os.path.join(phase_dir, "coupling_summary.json"))
