@@ -26,20 +26,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from checklist import check, failures  # noqa: E402
 
 
+def bench_command(scene, out, bin_dir, *options):
+    where = ["--out-dir", str(out), "--build-dir", str(bin_dir.parent)]
+    return ["/usr/bin/python3", str(ROOT / "bench" / "bench_scenes.py"), str(scene), *options, *where]
+
+
 def procedure_rows(bin_dir, tmp):
     scene = ROOT / "tests" / "scenes" / "data" / "tiny_procedure.yaml"
     out = tmp / "procedure_runs"
-    cmd = [
-        "/usr/bin/python3",
-        str(ROOT / "bench" / "bench_scenes.py"),
-        str(scene),
-        "--no-alone",
-        "--out-dir",
-        str(out),
-        "--build-dir",
-        str(bin_dir.parent),
-    ]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    r = subprocess.run(bench_command(scene, out, bin_dir, "--no-alone"), capture_output=True, text=True, timeout=900)
     print(r.stdout[-2000:], r.stderr[-1500:])
     check(r.returncode == 0, f"bench_scenes.py on a procedure exits 0 (got {r.returncode})")
     rows = json.load(open(out / "bench_scenes.json"))["rows"]
@@ -71,15 +66,7 @@ def main():
         path = tmp / "bench_short.yaml"
         yaml.safe_dump(scene, open(path, "w"))
         out = tmp / "runs"
-        cmd = [
-            "/usr/bin/python3",
-            str(ROOT / "bench" / "bench_scenes.py"),
-            str(path),
-            "--out-dir",
-            str(out),
-            "--build-dir",
-            str(bin_dir.parent),
-        ]
+        cmd = bench_command(path, out, bin_dir)
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
         print(r.stdout[-3000:], r.stderr[-2000:])
         check(r.returncode == 0, f"bench_scenes.py exits 0 (got {r.returncode})")
